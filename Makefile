@@ -1,0 +1,41 @@
+MAKEFLAGS += --no-print-directory
+# Thin driver around CMake. The two commands of the README:
+#   make run    set-up -> configure -> build -> run the default scene
+#   make test   set-up -> configure -> build -> ctest
+# Options: BUILD_DIR=build  JOBS=<n>  SCENE=<file or name>  KOKKOS_ROOT=<your Kokkos>
+BUILD_DIR ?= build
+JOBS ?= $(shell nproc)
+SCENE ?=
+OUT ?= results/default
+CMAKE_ARGS ?=
+
+ifdef KOKKOS_ROOT
+  SETUP_ENV = MFSI_SKIP_KOKKOS=1
+  KOKKOS_ARG = -DKokkos_ROOT=$(KOKKOS_ROOT)
+endif
+
+.PHONY: all deps configure build run test bench clean
+
+all: build
+
+deps:
+	@$(SETUP_ENV) bash scripts/setup-deps.sh > $(BUILD_DIR).deps.env.tmp && mv $(BUILD_DIR).deps.env.tmp $(BUILD_DIR).deps.env
+
+configure: deps
+	@kr="$(KOKKOS_ARG)"; if [ -z "$$kr" ]; then kr="-DKokkos_ROOT=$$(sed -n 's/^KOKKOS_ROOT=//p' $(BUILD_DIR).deps.env)"; fi; \
+	cmake -S . -B $(BUILD_DIR) -DCMAKE_BUILD_TYPE=Release $$kr $(CMAKE_ARGS) > /dev/null
+
+build: configure
+	@cmake --build $(BUILD_DIR) -j $(JOBS)
+
+run: build
+	@OMP_PROC_BIND=false ./$(BUILD_DIR)/apps/mfsi run $(SCENE) --out $(OUT)
+
+test: build
+	@cd $(BUILD_DIR) && OMP_PROC_BIND=false ctest --output-on-failure -j $(JOBS) --timeout 900
+
+bench: build
+	@bash perf/run_benchmarks.sh $(BUILD_DIR)
+
+clean:
+	rm -rf $(BUILD_DIR) $(BUILD_DIR).deps.env

@@ -1,0 +1,60 @@
+#pragma once
+/// \file
+/// \brief The one place that names execution spaces, memory spaces, View aliases and policies.
+///
+/// Every kernel in membrane-fsi runs in `mfsi::ExecSpace` on data in `mfsi::MemSpace`; host
+/// mirrors live in `mfsi::HostSpace`. Works against Kokkos 3.4 and 4.x (no deprecated API).
+#include <Kokkos_Core.hpp>
+
+#include <cstdint>
+#include <string>
+
+namespace mfsi {
+
+using ExecSpace = Kokkos::DefaultExecutionSpace;
+using MemSpace = ExecSpace::memory_space;
+using HostExecSpace = Kokkos::DefaultHostExecutionSpace;
+using HostSpace = Kokkos::HostSpace;
+
+using real = double;
+/// Local (per-rank) index of a node, face or cell. 32 bits: one rank never holds 2^31 entities.
+using lid_t = std::int32_t;
+/// Global index across all ranks.
+using gid_t = std::int64_t;
+
+using RandomRead = Kokkos::MemoryTraits<Kokkos::RandomAccess>;
+
+// Device views.
+using RealView = Kokkos::View<real*, MemSpace>;
+using Real3View = Kokkos::View<real* [3], MemSpace>;
+using IndexView = Kokkos::View<lid_t*, MemSpace>;
+using GlobalIndexView = Kokkos::View<gid_t*, MemSpace>;
+using Hex8View = Kokkos::View<lid_t* [8], MemSpace>;
+using Quad4View = Kokkos::View<lid_t* [4], MemSpace>;
+
+// Read-only variants for kernel inputs (texture / read-only cache paths on GPUs).
+using ConstRealView = Kokkos::View<const real*, MemSpace, RandomRead>;
+using ConstReal3View = Kokkos::View<const real* [3], MemSpace, RandomRead>;
+using ConstIndexView = Kokkos::View<const lid_t*, MemSpace, RandomRead>;
+using ConstHex8View = Kokkos::View<const lid_t* [8], MemSpace, RandomRead>;
+using ConstQuad4View = Kokkos::View<const lid_t* [4], MemSpace, RandomRead>;
+
+// Policies.
+using RangePolicy = Kokkos::RangePolicy<ExecSpace, Kokkos::IndexType<lid_t>>;
+using TeamPolicy = Kokkos::TeamPolicy<ExecSpace>;
+using HostRangePolicy = Kokkos::RangePolicy<HostExecSpace, Kokkos::IndexType<lid_t>>;
+
+/// \brief Name of the active default backend ("OpenMP", "Serial", "Cuda", ...).
+inline std::string backendName() { return ExecSpace::name(); }
+
+/// \brief RAII profiling region, named hierarchically (e.g. "mfsi::fluid::pressure").
+/// Kokkos 3.4 has no Kokkos::Profiling::ScopedRegion, so we keep our own.
+class ScopedRegion {
+ public:
+  explicit ScopedRegion(const std::string& name) { Kokkos::Profiling::pushRegion(name); }
+  ~ScopedRegion() { Kokkos::Profiling::popRegion(); }
+  ScopedRegion(const ScopedRegion&) = delete;
+  ScopedRegion& operator=(const ScopedRegion&) = delete;
+};
+
+}  // namespace mfsi
