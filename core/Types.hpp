@@ -44,6 +44,29 @@ using RangePolicy = Kokkos::RangePolicy<ExecSpace, Kokkos::IndexType<lid_t>>;
 using TeamPolicy = Kokkos::TeamPolicy<ExecSpace>;
 using HostRangePolicy = Kokkos::RangePolicy<HostExecSpace, Kokkos::IndexType<lid_t>>;
 
+/// \brief Device-callable math, portable across Kokkos 3.4 (Kokkos::Experimental) and 4.x (Kokkos::).
+namespace kmath {
+#if KOKKOS_VERSION >= 30700
+using Kokkos::acos;
+using Kokkos::atan2;
+using Kokkos::cos;
+using Kokkos::exp;
+using Kokkos::fabs;
+using Kokkos::pow;
+using Kokkos::sin;
+using Kokkos::sqrt;
+#else
+using Kokkos::Experimental::acos;
+using Kokkos::Experimental::atan2;
+using Kokkos::Experimental::cos;
+using Kokkos::Experimental::exp;
+using Kokkos::Experimental::fabs;
+using Kokkos::Experimental::pow;
+using Kokkos::Experimental::sin;
+using Kokkos::Experimental::sqrt;
+#endif
+}  // namespace kmath
+
 /// \brief Name of the active default backend ("OpenMP", "Serial", "Cuda", ...).
 inline std::string backendName() { return ExecSpace::name(); }
 

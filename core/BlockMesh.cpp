@@ -1,0 +1,190 @@
+#include "core/BlockMesh.hpp"
+
+#include "core/Error.hpp"
+
+#include <cmath>
+#include <tuple>
+
+namespace mfsi {
+
+namespace {
+
+std::vector<real> gradedCoordinates(real a, real b, int n, real ratio) {
+  std::vector<real> x(n + 1);
+  if (n == 1 || std::abs(ratio - 1.0) < 1e-14) {
+    for (int i = 0; i <= n; ++i) x[i] = a + (b - a) * i / n;
+  } else {
+    const real q = std::pow(ratio, 1.0 / (n - 1));
+    real sum = 0, s = 1;
+    for (int i = 0; i < n; ++i, s *= q) sum += s;
+    real pos = a, h = (b - a) / sum;
+    x[0] = a;
+    for (int i = 1; i <= n; ++i, h *= q) x[i] = (pos += h);
+    x[n] = b;
+  }
+  return x;
+}
+
+}  // namespace
+
+BlockMeshSpec boxSpec(std::array<real, 3> min, std::array<real, 3> max, std::array<int, 3> cells) {
+  BlockMeshSpec s;
+  BlockSpec b;
+  b.min = min;
+  b.max = max;
+  b.cells = cells;
+  s.blocks.push_back(b);
+  return s;
+}
+
+HexMeshInput generateBlockMesh(const BlockMeshSpec& spec) {
+  MFSI_CHECK(!spec.blocks.empty(), "blockMesh: no blocks");
+  HexMeshInput out;
+  out.source = "blockMesh";
+  out.defaultPatch = spec.defaultPatch;
+
+  // Bounding box, for the merge tolerance.
+  std::array<real, 3> lo = spec.blocks[0].min, hi = spec.blocks[0].max;
+  for (std::size_t b = 0; b < spec.blocks.size(); ++b) {
+    const auto& bl = spec.blocks[b];
+    for (int d = 0; d < 3; ++d) {
+      MFSI_CHECK(bl.cells[d] >= 1, "blockMesh: block " << b << " needs at least one cell in direction " << d);
+      MFSI_CHECK(bl.max[d] > bl.min[d], "blockMesh: block " << b << " has max <= min in direction " << d);
+      MFSI_CHECK(bl.grading[d] > 0, "blockMesh: block " << b << " has non-positive grading in direction " << d);
+      lo[d] = std::min(lo[d], bl.min[d]);
+      hi[d] = std::max(hi[d], bl.max[d]);
+    }
+  }
+  const real diag = std::sqrt((hi[0] - lo[0]) * (hi[0] - lo[0]) + (hi[1] - lo[1]) * (hi[1] - lo[1]) +
+                              (hi[2] - lo[2]) * (hi[2] - lo[2]));
+  const real tol = spec.mergeTolerance * diag;
+
+  // Merge coincident nodes through a quantised-coordinate map.
+  std::map<std::tuple<long long, long long, long long>, lid_t> nodeOf;
+  auto addPoint = [&](real x, real y, real z) -> lid_t {
+    auto qz = [&](real v) { return static_cast<long long>(std::llround(v / (tol > 0 ? tol : 1e-300) / 4.0)); };
+    // Look in the neighbouring quantisation cells too, so points straddling a cell edge merge.
+    const auto base = std::make_tuple(qz(x), qz(y), qz(z));
+    for (int dx = -1; dx <= 1; ++dx)
+      for (int dy = -1; dy <= 1; ++dy)
+        for (int dz = -1; dz <= 1; ++dz) {
+          auto it = nodeOf.find({std::get<0>(base) + dx, std::get<1>(base) + dy, std::get<2>(base) + dz});
+          if (it == nodeOf.end()) continue;
+          const auto& p = out.points[it->second];
+          if (std::abs(p[0] - x) <= tol && std::abs(p[1] - y) <= tol && std::abs(p[2] - z) <= tol) return it->second;
+        }
+    const lid_t id = static_cast<lid_t>(out.points.size());
+    out.points.push_back({x, y, z});
+    nodeOf.emplace(base, id);
+    return id;
+  };
+
+  std::map<std::string, std::size_t> patchOf;
+  for (std::size_t b = 0; b < spec.blocks.size(); ++b) {
+    const auto& bl = spec.blocks[b];
+    const int nx = bl.cells[0], ny = bl.cells[1], nz = bl.cells[2];
+    const auto xs = gradedCoordinates(bl.min[0], bl.max[0], nx, bl.grading[0]);
+    const auto ys = gradedCoordinates(bl.min[1], bl.max[1], ny, bl.grading[1]);
+    const auto zs = gradedCoordinates(bl.min[2], bl.max[2], nz, bl.grading[2]);
+    std::vector<lid_t> nid(static_cast<std::size_t>(nx + 1) * (ny + 1) * (nz + 1));
+    auto at = [&](int i, int j, int k) -> lid_t& { return nid[(static_cast<std::size_t>(k) * (ny + 1) + j) * (nx + 1) + i]; };
+    for (int k = 0; k <= nz; ++k)
+      for (int j = 0; j <= ny; ++j)
+        for (int i = 0; i <= nx; ++i) at(i, j, k) = addPoint(xs[i], ys[j], zs[k]);
+
+    const lid_t cell0 = static_cast<lid_t>(out.cells.size());
+    for (int k = 0; k < nz; ++k)
+      for (int j = 0; j < ny; ++j)
+        for (int i = 0; i < nx; ++i)
+          out.cells.push_back({at(i, j, k), at(i + 1, j, k), at(i + 1, j + 1, k), at(i, j + 1, k), at(i, j, k + 1),
+                               at(i + 1, j, k + 1), at(i + 1, j + 1, k + 1), at(i, j + 1, k + 1)});
+    auto cellAt = [&](int i, int j, int k) { return cell0 + (k * ny + j) * nx + i; };
+
+    // Side faces (local hex face ids: z- 0, z+ 1, y- 2, y+ 3, x- 4, x+ 5).
+    const int sideLocal[6] = {4, 5, 2, 3, 0, 1};
+    for (int side = 0; side < 6; ++side) {
+      const std::string& name = bl.patches[side];
+      if (name.empty()) continue;
+      auto it = patchOf.find(name);
+      if (it == patchOf.end()) {
+        HexMeshInput::PatchSpec ps;
+        ps.name = name;
+        auto kit = spec.patchKinds.find(name);
+        if (kit != spec.patchKinds.end()) ps.kind = kit->second;
+        it = patchOf.emplace(name, out.patches.size()).first;
+        out.patches.push_back(ps);
+      }
+      auto& faces = out.patches[it->second].faces;
+      const int dir = side / 2;
+      const bool upper = side % 2 == 1;
+      for (int k = 0; k < nz; ++k)
+        for (int j = 0; j < ny; ++j)
+          for (int i = 0; i < nx; ++i) {
+            const int idx[3] = {i, j, k};
+            const int n[3] = {nx, ny, nz};
+            if (idx[dir] != (upper ? n[dir] - 1 : 0)) continue;
+            const auto& cn = out.cells[cellAt(i, j, k)];
+            std::array<lid_t, 4> q;
+            for (int a = 0; a < 4; ++a) q[a] = cn[kHexFaces[sideLocal[side]][a]];
+            faces.push_back(q);
+          }
+    }
+  }
+
+  // Drop patch faces that gluing made internal.
+  {
+    std::map<std::array<lid_t, 4>, int> count;
+    for (const auto& c : out.cells)
+      for (const auto& lf : kHexFaces) {
+        std::array<lid_t, 4> q = {c[lf[0]], c[lf[1]], c[lf[2]], c[lf[3]]};
+        std::sort(q.begin(), q.end());
+        ++count[q];
+      }
+    for (auto& p : out.patches) {
+      std::vector<std::array<lid_t, 4>> keep;
+      for (const auto& q : p.faces) {
+        auto k = q;
+        std::sort(k.begin(), k.end());
+        if (count[k] == 1) keep.push_back(q);
+      }
+      p.faces.swap(keep);
+    }
+    std::vector<HexMeshInput::PatchSpec> nonEmpty;
+    for (auto& p : out.patches)
+      if (!p.faces.empty()) nonEmpty.push_back(std::move(p));
+    out.patches.swap(nonEmpty);
+
+    // Baffles: cell faces looking along +axis that lie on the plane inside the rectangle.
+    const int plusFace[3] = {5, 3, 1};
+    for (const auto& br : spec.baffles) {
+      MFSI_CHECK(br.axis >= 0 && br.axis <= 2, "blockMesh: baffle '" << br.name << "' axis must be 0, 1 or 2");
+      HexMeshInput::BaffleSpec bs;
+      bs.name = br.name;
+      for (const auto& c : out.cells) {
+        std::array<lid_t, 4> q;
+        real ctr[3] = {0, 0, 0};
+        bool onPlane = true;
+        for (int a = 0; a < 4; ++a) {
+          q[a] = c[kHexFaces[plusFace[br.axis]][a]];
+          const auto& p = out.points[q[a]];
+          onPlane = onPlane && std::abs(p[br.axis] - br.position) <= std::max(tol, 1e-12);
+          for (int d = 0; d < 3; ++d) ctr[d] += 0.25 * p[d];
+        }
+        if (!onPlane) continue;
+        bool inside = true;
+        for (int d = 0; d < 3; ++d)
+          if (d != br.axis) inside = inside && ctr[d] >= br.min[d] - tol && ctr[d] <= br.max[d] + tol;
+        if (!inside) continue;
+        auto k = q;
+        std::sort(k.begin(), k.end());
+        if (count[k] == 2) bs.faces.push_back(q);
+      }
+      MFSI_CHECK(!bs.faces.empty(), "blockMesh: baffle '" << br.name << "' selects no internal face (plane "
+                                                          << "xyz"[br.axis] << " = " << br.position << ")");
+      out.baffles.push_back(std::move(bs));
+    }
+  }
+  return out;
+}
+
+}  // namespace mfsi
