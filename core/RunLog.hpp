@@ -1,0 +1,74 @@
+#pragma once
+/// \file
+/// \brief What every run leaves behind: `summary.json` (the stable machine-readable contract),
+/// a per-step CSV log, and a progress display.
+#include <cstdio>
+#include <fstream>
+#include <map>
+#include <string>
+#include <vector>
+
+namespace mfsi {
+
+/// \brief Contents of summary.json:
+/// {"scene","status","error","wall_s","steps","sim_time","cells","nodes","ranks","threads","backend",
+///  "timers":{phase: s},"metrics":{name: number}}.
+struct RunSummary {
+  std::string scene;
+  std::string status = "ok";  ///< "ok" | "diverged" | "error"
+  std::string error;          ///< empty -> null
+  double wallSeconds = 0.0;
+  long long steps = 0;
+  double simTime = 0.0;
+  long long cells = 0;
+  long long nodes = 0;
+  int ranks = 1;
+  int threads = 1;
+  std::string backend;
+  std::map<std::string, double> timers;
+  std::map<std::string, double> metrics;
+};
+
+/// JSON text of a summary (non-finite numbers are written as null).
+std::string toJson(const RunSummary& s);
+
+/// Write `dir/summary.json` atomically (temporary file + rename); creates `dir`.
+void writeSummary(const std::string& dir, const RunSummary& s);
+
+/// Escape a string for JSON.
+std::string jsonEscape(const std::string& s);
+
+/// \brief Per-step CSV log (`steps.csv`): a header of column names, then one row per step.
+class StepLog {
+ public:
+  StepLog() = default;
+  StepLog(const std::string& path, std::vector<std::string> columns);
+  void row(const std::vector<double>& values);
+  bool isOpen() const { return out_.is_open(); }
+
+ private:
+  std::ofstream out_;
+  std::size_t nColumns_ = 0;
+};
+
+/// \brief One-line progress display (step, simulated time, ETA) on a terminal; plain lines at
+/// most every `plainEvery` steps otherwise.
+class Progress {
+ public:
+  Progress(long long totalSteps, double endTime, bool terminal, int plainEvery = 0);
+  void update(long long step, double simTime);
+  void finish();
+
+ private:
+  long long total_;
+  double endTime_;
+  bool terminal_;
+  int plainEvery_;
+  double start_;
+  bool drew_ = false;
+};
+
+/// Whether stdout is a terminal.
+bool stdoutIsTerminal();
+
+}  // namespace mfsi
