@@ -2,6 +2,7 @@
 
 #include "core/Error.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <tuple>
 
@@ -133,19 +134,26 @@ HexMeshInput generateBlockMesh(const BlockMeshSpec& spec) {
 
   // Drop patch faces that gluing made internal.
   {
-    std::map<std::array<lid_t, 4>, int> count;
+    // Sorted keys of every cell face: a key seen twice is an internal face.
+    std::vector<std::array<lid_t, 4>> keys;
+    keys.reserve(out.cells.size() * 6);
     for (const auto& c : out.cells)
       for (const auto& lf : kHexFaces) {
         std::array<lid_t, 4> q = {c[lf[0]], c[lf[1]], c[lf[2]], c[lf[3]]};
         std::sort(q.begin(), q.end());
-        ++count[q];
+        keys.push_back(q);
       }
+    std::sort(keys.begin(), keys.end());
+    auto count = [&keys](const std::array<lid_t, 4>& k) {
+      const auto r = std::equal_range(keys.begin(), keys.end(), k);
+      return static_cast<int>(r.second - r.first);
+    };
     for (auto& p : out.patches) {
       std::vector<std::array<lid_t, 4>> keep;
       for (const auto& q : p.faces) {
         auto k = q;
         std::sort(k.begin(), k.end());
-        if (count[k] == 1) keep.push_back(q);
+        if (count(k) == 1) keep.push_back(q);
       }
       p.faces.swap(keep);
     }
@@ -177,7 +185,7 @@ HexMeshInput generateBlockMesh(const BlockMeshSpec& spec) {
         if (!inside) continue;
         auto k = q;
         std::sort(k.begin(), k.end());
-        if (count[k] == 2) bs.faces.push_back(q);
+        if (count(k) == 2) bs.faces.push_back(q);
       }
       MFSI_CHECK(!bs.faces.empty(), "blockMesh: baffle '" << br.name << "' selects no internal face (plane "
                                                           << "xyz"[br.axis] << " = " << br.position << ")");
