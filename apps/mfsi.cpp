@@ -1,0 +1,217 @@
+// mfsi — the membrane-fsi command.
+//
+//   mfsi run                                  # the default scene, results in results/<scene>/
+//   mfsi run cases/box.yaml --out /tmp/box --threads 2
+//   mfsi run box --set mesh.blocks.0.cells=[32,32,8]
+//   mfsi check cases/box.yaml                 # validate without running (also builds the mesh)
+//   mfsi check --describe                     # every scene key with type, default, units, doc
+//   mfsi scenes                               # built-in scenes
+//   mfsi --version
+//
+// Exit codes: 0 ok, 2 bad input (scene, mesh, command line), 3 diverged, 1 internal error.
+// Every `run` writes <out>/summary.json (also on errors), <out>/scene.yaml and <out>/steps.csv.
+#include "coupling/Simulation.hpp"
+#include "core/RunLog.hpp"
+
+#include <CLI/CLI.hpp>
+#include <mpi.h>
+
+#include <filesystem>
+#include <fstream>
+#include <iostream>
+
+namespace fs = std::filesystem;
+
+namespace {
+
+constexpr const char* kDefaultScene = "box";
+
+std::vector<fs::path> caseDirs() {
+  std::vector<fs::path> dirs;
+  if (const char* env = std::getenv("MFSI_CASES_DIR")) dirs.emplace_back(env);
+  dirs.emplace_back(MFSI_SOURCE_CASES_DIR);
+  std::error_code ec;
+  const fs::path exe = fs::read_symlink("/proc/self/exe", ec);
+  if (!ec) dirs.push_back(exe.parent_path().parent_path() / "share" / "mfsi" / "cases");
+  return dirs;
+}
+
+/// A path to a scene file, or the name of a built-in scene.
+fs::path resolveScene(const std::string& arg) {
+  if (fs::exists(arg) && !fs::is_directory(arg)) return arg;
+  for (const auto& d : caseDirs()) {
+    const fs::path p = d / (arg + ".yaml");
+    if (fs::exists(p)) return p;
+  }
+  throw mfsi::InputError("cannot open scene file '" + arg + "' (not a file, nor a built-in scene; see `mfsi scenes`)");
+}
+
+std::string sceneName(const mfsi::SceneConfig& cfg, const fs::path& file) {
+  const std::string n = cfg.get<std::string>("name");
+  return n.empty() ? file.stem().string() : n;
+}
+
+int threadCount() { return mfsi::ExecSpace().concurrency(); }
+
+int commandScenes() {
+  for (const auto& d : caseDirs()) {
+    if (!fs::is_directory(d)) continue;
+    std::vector<fs::path> files;
+    for (const auto& e : fs::directory_iterator(d))
+      if (e.path().extension() == ".yaml") files.push_back(e.path());
+    std::sort(files.begin(), files.end());
+    std::cout << "scenes in " << d.string() << ":\n";
+    for (const auto& f : files) {
+      std::string description;
+      try {
+        description = mfsi::SceneConfig::load(f.string(), mfsi::sceneSchema()).get<std::string>("description");
+      } catch (const std::exception& e) {
+        description = std::string("(invalid: ") + e.what() + ")";
+      }
+      std::cout << "  " << f.stem().string() << (f.stem() == kDefaultScene ? " (default)" : "") << "  — "
+                << description << "\n";
+    }
+    return 0;
+  }
+  std::cerr << "no scene folder found\n";
+  return 2;
+}
+
+int commandCheck(const std::string& scene, const std::vector<std::string>& sets, bool describe) {
+  if (describe) {
+    std::cout << mfsi::describeSchema(mfsi::sceneSchema());
+    return 0;
+  }
+  try {
+    const fs::path file = resolveScene(scene);
+    const auto cfg = mfsi::SceneConfig::load(file.string(), mfsi::sceneSchema(), sets);
+    mfsi::Simulation sim(cfg);
+    std::cout << "ok: " << file.string() << ": scene '" << sceneName(cfg, file) << "', " << sim.mesh().nCells()
+              << " cells, " << sim.mesh().nNodes() << " nodes, " << sim.modules().size() << " module(s)\n";
+    return 0;
+  } catch (const mfsi::InputError& e) {
+    std::cerr << "error: " << e.what() << "\n";
+    return 2;
+  }
+}
+
+int commandRun(const std::string& sceneArg, const std::vector<std::string>& sets, std::string out) {
+  const double t0 = mfsi::wallSeconds();
+  mfsi::RunSummary summary;
+  summary.scene = sceneArg;
+  summary.backend = mfsi::backendName();
+  summary.threads = threadCount();
+  MPI_Comm_size(MPI_COMM_WORLD, &summary.ranks);
+  int rank = 0;
+  MPI_Comm_rank(MPI_COMM_WORLD, &rank);
+  int code = 0;
+  std::unique_ptr<mfsi::Simulation> sim;
+  if (out.empty()) out = (fs::path("results") / fs::path(sceneArg).stem()).string();
+  try {
+    const fs::path file = resolveScene(sceneArg);
+    const auto cfg = mfsi::SceneConfig::load(file.string(), mfsi::sceneSchema(), sets);
+    summary.scene = sceneName(cfg, file);
+    const std::string resolved = cfg.resolvedYaml();
+    if (rank == 0) {
+      std::cout << "mfsi " << MFSI_VERSION << " | scene " << file.string() << " | backend " << summary.backend << " x"
+                << summary.threads << " threads | " << summary.ranks << " rank(s)\n"
+                << "---- resolved scene ----\n"
+                << resolved << "------------------------\n";
+    }
+    sim = std::make_unique<mfsi::Simulation>(cfg);
+    summary.cells = sim->mesh().nCells();
+    summary.nodes = sim->mesh().nNodes();
+    fs::create_directories(out);
+    {
+      std::ofstream s(out + "/scene.yaml");
+      s << resolved;
+    }
+    const auto result = sim->run(out, rank == 0 && mfsi::stdoutIsTerminal());
+    summary.steps = result.steps;
+    summary.simTime = result.simTime;
+    summary.metrics = result.metrics;
+  } catch (const mfsi::InputError& e) {
+    summary.status = "error";
+    summary.error = e.what();
+    std::cerr << "error: " << e.what() << "\n";
+    code = 2;
+  } catch (const mfsi::DivergenceError& e) {
+    summary.status = "diverged";
+    summary.error = e.what();
+    std::cerr << "diverged: " << e.what() << "\n";
+    code = 3;
+  } catch (const std::exception& e) {
+    summary.status = "error";
+    summary.error = std::string("internal error: ") + e.what();
+    std::cerr << "internal error: " << e.what() << "\n";
+    code = 1;
+  }
+  if (sim) summary.timers = sim->timers().all();
+  summary.wallSeconds = mfsi::wallSeconds() - t0;
+  if (rank == 0) {
+    try {
+      mfsi::writeSummary(out, summary);
+      std::cout << (code == 0 ? "done" : "failed") << " in " << summary.wallSeconds << " s; results in " << out
+                << "/ (summary.json)\n";
+    } catch (const std::exception& e) {
+      std::cerr << "error: cannot write the summary: " << e.what() << "\n";
+      if (code == 0) code = 2;
+    }
+  }
+  return code;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  CLI::App app{"membrane-fsi: fluid-structure interaction of flexible membranes"};
+  app.set_version_flag("--version", std::string("mfsi ") + MFSI_VERSION);
+  app.require_subcommand(1);
+
+  std::string scene = kDefaultScene, out;
+  std::vector<std::string> sets;
+  int threads = 0;
+  bool describe = false;
+
+  auto* run = app.add_subcommand("run", "run a scene (default: the built-in default scene)");
+  run->add_option("scene", scene, "scene file, or the name of a built-in scene");
+  run->add_option("--set", sets, "override a scene value: --set a.b.c=value (repeatable)");
+  run->add_option("--out", out, "output folder (default: results/<scene>)");
+  run->add_option("--threads", threads, "host threads (default: OMP_NUM_THREADS or all cores)")->check(CLI::PositiveNumber);
+
+  auto* check = app.add_subcommand("check", "validate a scene without running it");
+  check->add_option("scene", scene, "scene file, or the name of a built-in scene");
+  check->add_option("--set", sets, "override a scene value: --set a.b.c=value (repeatable)");
+  check->add_flag("--describe", describe, "list every scene key with type, default, units and doc");
+
+  app.add_subcommand("scenes", "list the built-in scenes");
+
+  CLI11_PARSE(app, argc, argv);
+
+  MPI_Init(&argc, &argv);
+  int code = 0;
+  {
+    // Kokkos options are passed as arguments: the spelling of the thread-count flag changed in 4.x.
+    std::vector<std::string> kargs = {argv[0], "--kokkos-disable-warnings"};
+    if (threads > 0) {
+#if KOKKOS_VERSION >= 40000
+      kargs.push_back("--kokkos-num-threads=" + std::to_string(threads));
+#else
+      kargs.push_back("--kokkos-threads=" + std::to_string(threads));
+#endif
+    }
+    std::vector<char*> kargv;
+    for (auto& a : kargs) kargv.push_back(a.data());
+    int kargc = static_cast<int>(kargv.size());
+    Kokkos::ScopeGuard kokkos(kargc, kargv.data());
+    if (app.got_subcommand("run")) {
+      code = commandRun(scene, sets, out);
+    } else if (app.got_subcommand("check")) {
+      code = commandCheck(scene, sets, describe);
+    } else {
+      code = commandScenes();
+    }
+  }
+  MPI_Finalize();
+  return code;
+}

@@ -1,0 +1,22 @@
+#include "coupling/Module.hpp"
+
+namespace mfsi {
+
+namespace {
+std::map<std::string, int>& counts() {
+  static std::map<std::string, int> c;
+  return c;
+}
+}  // namespace
+
+Module::Module(std::string name) : name_(std::move(name)) { ++counts()[name_]; }
+
+const std::map<std::string, int>& Module::constructionCounts() { return counts(); }
+
+const std::vector<ModuleEntry>& moduleCatalogue() {
+  // Physics modules register here as they land (fluid, membranes, bodies, coupling).
+  static const std::vector<ModuleEntry> catalogue = {};
+  return catalogue;
+}
+
+}  // namespace mfsi

@@ -1,0 +1,65 @@
+#pragma once
+/// \file
+/// \brief A physics module of a run (fluid, a membrane, the rigid frames, the FSI coupling).
+///
+/// Design rationale: which physics a run simulates is decided by the scene at run time — a scene
+/// names its effects, and a module it does not name must never be constructed (it allocates
+/// nothing, launches no kernel, costs nothing). So modules are created on demand from a catalogue
+/// of (scene section -> factory), and the driver talks to them through this small host-side
+/// interface. Virtual calls happen once per step on the host, never inside kernels.
+#include "core/Fields.hpp"
+#include "core/MeshGeometry.hpp"
+#include "core/SceneConfig.hpp"
+#include "core/Timers.hpp"
+
+#include <functional>
+#include <map>
+#include <memory>
+#include <string>
+#include <vector>
+
+namespace mfsi {
+
+/// \brief What a module may use while it is built and run.
+struct SimulationContext {
+  HexMesh& mesh;
+  MeshGeometry& geometry;
+  Timers& timers;
+};
+
+class Module {
+ public:
+  explicit Module(std::string name);
+  virtual ~Module() = default;
+  Module(const Module&) = delete;
+  Module& operator=(const Module&) = delete;
+
+  const std::string& name() const { return name_; }
+  /// Advance over [t.time, t.time + t.dt]. Throws DivergenceError when the solution is lost.
+  virtual void advance(const TimeState& t) = 0;
+  /// Named summary numbers for summary.json ("<module>.<what>").
+  virtual void addMetrics(std::map<std::string, double>& /*metrics*/) const {}
+  /// Column names and values of this module in steps.csv.
+  virtual std::vector<std::string> stepColumns() const { return {}; }
+  virtual void appendStepValues(std::vector<double>& /*values*/) const {}
+
+  /// How many modules of each name were ever constructed in this process (for tests of the
+  /// "a module the scene does not name costs nothing" rule).
+  static const std::map<std::string, int>& constructionCounts();
+
+ private:
+  std::string name_;
+};
+
+/// \brief One entry of the module catalogue: the scene section that switches the module on, the
+/// schema of that section, and the factory.
+struct ModuleEntry {
+  std::string section;
+  std::function<Schema()> schema;
+  std::function<std::vector<std::unique_ptr<Module>>(const SceneConfig& section, SimulationContext& ctx)> create;
+};
+
+/// Every module the code knows, in construction order.
+const std::vector<ModuleEntry>& moduleCatalogue();
+
+}  // namespace mfsi

@@ -1,0 +1,49 @@
+#pragma once
+/// \file
+/// \brief The run driver: builds the mesh and exactly the modules a scene names, then steps them.
+#include "coupling/Module.hpp"
+#include "core/RunLog.hpp"
+
+namespace mfsi {
+
+/// Schema of a whole scene: name, description, mesh, time, and one section per catalogued module.
+Schema sceneSchema();
+
+/// \brief Time stepping of the `time` section.
+struct TimeOptions {
+  real endTime = 0.0;  ///< 0: no time stepping (a mesh-only scene)
+  real dt = 0.0;
+  int maxSteps = 0;  ///< 0: as many as endTime/dt needs
+};
+
+/// \brief What `Simulation::run` reports back.
+struct RunResult {
+  long long steps = 0;
+  double simTime = 0.0;
+  std::map<std::string, double> metrics;
+};
+
+class Simulation {
+ public:
+  /// Build the mesh and the modules the scene names. Throws InputError on bad input.
+  explicit Simulation(const SceneConfig& scene);
+
+  /// Step to the end time, writing steps.csv into `outDir` and drawing progress.
+  RunResult run(const std::string& outDir, bool terminal);
+
+  const HexMesh& mesh() const { return mesh_; }
+  const std::vector<std::unique_ptr<Module>>& modules() const { return modules_; }
+  Timers& timers() { return timers_; }
+  const TimeOptions& timeOptions() const { return time_; }
+
+ private:
+  void meshMetrics(std::map<std::string, double>& m) const;
+
+  Timers timers_;
+  HexMesh mesh_;
+  MeshGeometry geometry_;
+  TimeOptions time_;
+  std::vector<std::unique_ptr<Module>> modules_;
+};
+
+}  // namespace mfsi

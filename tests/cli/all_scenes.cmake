@@ -1,0 +1,26 @@
+# Every scene in cases/ runs at a small size. A scene may carry a line
+#   # test: --set key=value --set key=value
+# with the overrides that make it small; the run must end with status "ok".
+file(REMOVE_RECURSE ${WORK})
+file(GLOB scenes ${CASES}/*.yaml)
+foreach(scene ${scenes})
+  get_filename_component(name ${scene} NAME_WE)
+  file(STRINGS ${scene} test_line REGEX "^# test: ")
+  set(args "")
+  if(test_line)
+    string(REPLACE "# test: " "" args_text "${test_line}")
+    separate_arguments(args UNIX_COMMAND "${args_text}")
+  endif()
+  execute_process(COMMAND ${MFSI} run ${scene} ${args} --out ${WORK}/${name}
+    RESULT_VARIABLE rc OUTPUT_VARIABLE o ERROR_VARIABLE e)
+  if(NOT rc EQUAL 0)
+    message(SEND_ERROR "scene ${name} failed (${rc}):\n${e}")
+    continue()
+  endif()
+  file(READ ${WORK}/${name}/summary.json js)
+  string(JSON status GET "${js}" status)
+  if(NOT status STREQUAL "ok")
+    message(SEND_ERROR "scene ${name}: status ${status}")
+  endif()
+  message(STATUS "scene ${name}: ok")
+endforeach()
