@@ -27,6 +27,7 @@ function(mfsi_library)
       $<BUILD_INTERFACE:${PROJECT_SOURCE_DIR}> $<INSTALL_INTERFACE:${CMAKE_INSTALL_INCLUDEDIR}/mfsi>)
     target_link_libraries(${target} INTERFACE ${L_DEPS})
   endif()
+  set_target_properties(${target} PROPERTIES EXPORT_NAME ${L_NAME})
   add_library(mfsi::${L_NAME} ALIAS ${target})
   install(TARGETS ${target} EXPORT mfsiTargets ARCHIVE DESTINATION ${CMAKE_INSTALL_LIBDIR})
   install(DIRECTORY ${CMAKE_CURRENT_SOURCE_DIR}/ DESTINATION ${CMAKE_INSTALL_INCLUDEDIR}/mfsi/${L_NAME}
