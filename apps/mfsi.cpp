@@ -86,8 +86,9 @@ int commandCheck(const std::string& scene, const std::vector<std::string>& sets,
     const fs::path file = resolveScene(scene);
     const auto cfg = mfsi::SceneConfig::load(file.string(), mfsi::sceneSchema(), sets);
     mfsi::Simulation sim(cfg);
-    std::cout << "ok: " << file.string() << ": scene '" << sceneName(cfg, file) << "', " << sim.mesh().nCells()
-              << " cells, " << sim.mesh().nNodes() << " nodes, " << sim.modules().size() << " module(s)\n";
+    std::cout << "ok: " << file.string() << ": scene '" << sceneName(cfg, file) << "', "
+              << (sim.hasMesh() ? sim.mesh().nCells() : 0) << " cells, " << (sim.hasMesh() ? sim.mesh().nNodes() : 0)
+              << " nodes, " << sim.modules().size() << " module(s)\n";
     return 0;
   } catch (const mfsi::InputError& e) {
     std::cerr << "error: " << e.what() << "\n";
@@ -119,8 +120,10 @@ int commandRun(const std::string& sceneArg, const std::vector<std::string>& sets
                 << resolved << "------------------------\n";
     }
     sim = std::make_unique<mfsi::Simulation>(cfg);
-    summary.cells = sim->mesh().nCells();
-    summary.nodes = sim->mesh().nNodes();
+    if (sim->hasMesh()) {
+      summary.cells = sim->mesh().nCells();
+      summary.nodes = sim->mesh().nNodes();
+    }
     fs::create_directories(out);
     {
       std::ofstream s(out + "/scene.yaml");

@@ -1,5 +1,7 @@
 #include "coupling/Module.hpp"
 
+#include "coupling/RigidModule.hpp"
+
 namespace mfsi {
 
 namespace {
@@ -15,7 +17,7 @@ const std::map<std::string, int>& Module::constructionCounts() { return counts()
 
 const std::vector<ModuleEntry>& moduleCatalogue() {
   // Physics modules register here as they land (fluid, membranes, bodies, coupling).
-  static const std::vector<ModuleEntry> catalogue = {};
+  static const std::vector<ModuleEntry> catalogue = {rigidModuleEntry()};
   return catalogue;
 }
 

@@ -22,9 +22,9 @@ namespace mfsi {
 
 /// \brief What a module may use while it is built and run.
 struct SimulationContext {
-  HexMesh& mesh;
-  MeshGeometry& geometry;
-  Timers& timers;
+  HexMesh* mesh = nullptr;  ///< null when the scene has no `mesh` section
+  MeshGeometry* geometry = nullptr;
+  Timers* timers = nullptr;
 };
 
 class Module {
@@ -39,6 +39,8 @@ class Module {
   virtual void advance(const TimeState& t) = 0;
   /// Named summary numbers for summary.json ("<module>.<what>").
   virtual void addMetrics(std::map<std::string, double>& /*metrics*/) const {}
+  /// Open the module's own output files in the run's output folder (before the first step).
+  virtual void openOutput(const std::string& /*dir*/) {}
   /// Column names and values of this module in steps.csv.
   virtual std::vector<std::string> stepColumns() const { return {}; }
   virtual void appendStepValues(std::vector<double>& /*values*/) const {}

@@ -10,7 +10,7 @@ Schema sceneSchema() {
   Schema s = Schema::map("a membrane-fsi scene");
   s.key("name", Schema::string("scene name (default: the file name)"), Default(""))
       .key("description", Schema::string("what the scene demonstrates"), Default(""))
-      .key("mesh", meshSchema())
+      .key("mesh", meshSchema(), Presence::OptionalSection)
       .key("time", Schema::map("time stepping")
                        .key("endTime", Schema::real("simulated end time (0: no stepping)", "s").atLeast(0), Default(0.0))
                        .key("dt", Schema::real("time step", "s").atLeast(0), Default(0.0))
@@ -21,7 +21,8 @@ Schema sceneSchema() {
 }
 
 Simulation::Simulation(const SceneConfig& scene) {
-  {
+  hasMesh_ = scene.has("mesh");
+  if (hasMesh_) {
     ScopedTimer t(timers_, "mesh");
     mesh_ = buildMesh(scene.child("mesh"));
     geometry_ = allocateGeometry(mesh_);
@@ -34,15 +35,23 @@ Simulation::Simulation(const SceneConfig& scene) {
   if (time_.endTime > 0 && time_.dt <= 0)
     throw InputError(scene.where("time.dt"), "a positive time step is needed when time.endTime > 0");
 
-  SimulationContext ctx{mesh_, geometry_, timers_};
+  SimulationContext ctx;
+  if (hasMesh_) {
+    ctx.mesh = &mesh_;
+    ctx.geometry = &geometry_;
+  }
+  ctx.timers = &timers_;
   for (const auto& entry : moduleCatalogue()) {
     if (!scene.has(entry.section)) continue;  // not named: never constructed
     ScopedTimer t(timers_, "setup." + entry.section);
     for (auto& m : entry.create(scene.child(entry.section), ctx)) modules_.push_back(std::move(m));
   }
+  if (!hasMesh_ && modules_.empty())
+    throw InputError(scene.where(), "the scene names nothing to simulate: give at least a 'mesh' or a physics section");
 }
 
 void Simulation::meshMetrics(std::map<std::string, double>& m) const {
+  if (!hasMesh_) return;
   const MeshQuality q = computeQuality(ExecSpace(), mesh_, geometry_);
   m["mesh.min_scaled_jacobian"] = q.minScaledJacobian;
   m["mesh.max_non_orthogonality_deg"] = q.maxNonOrthogonality;
@@ -67,6 +76,7 @@ RunResult Simulation::run(const std::string& outDir, bool terminal) {
   for (const auto& m : modules_)
     for (const auto& c : m->stepColumns()) columns.push_back(m->name() + "." + c);
   StepLog log(outDir + "/steps.csv", columns);
+  for (auto& m : modules_) m->openOutput(outDir);
   Progress progress(nSteps, time_.endTime, terminal);
   TimeState ts;
   ts.endTime = time_.endTime;

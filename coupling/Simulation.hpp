@@ -31,6 +31,8 @@ class Simulation {
   /// Step to the end time, writing steps.csv into `outDir` and drawing progress.
   RunResult run(const std::string& outDir, bool terminal);
 
+  /// True when the scene has a `mesh` section (a rigid-only or membrane-only scene has none).
+  bool hasMesh() const { return hasMesh_; }
   const HexMesh& mesh() const { return mesh_; }
   const std::vector<std::unique_ptr<Module>>& modules() const { return modules_; }
   Timers& timers() { return timers_; }
@@ -40,6 +42,7 @@ class Simulation {
   void meshMetrics(std::map<std::string, double>& m) const;
 
   Timers timers_;
+  bool hasMesh_ = false;
   HexMesh mesh_;
   MeshGeometry geometry_;
   TimeOptions time_;

@@ -32,3 +32,27 @@ TEST(Effects, MeshOnlySceneBuildsNoModuleAndAllocatesOnlyCoreData) {
   // Every allocation is labelled hierarchically.
   for (const auto& l : rec.all()) EXPECT_EQ(l.rfind("mfsi::", 0), 0u) << "unlabelled View '" << l << "'";
 }
+
+TEST(Effects, RigidOnlySceneBuildsOnlyTheBodiesModuleAndNoMesh) {
+  const char* scene = R"(
+time: {endTime: 0.01, dt: 0.001}
+bodies:
+  gravity: [0, -9.81, 0]
+  members:
+    bob: {mass: 2.0, joint: {type: Py}}
+)";
+  mfsi::test::AllocationRecorder rec;
+  auto before = mfsi::Module::constructionCounts();
+  auto cfg = mfsi::SceneConfig::fromString(scene, "rigid.yaml", mfsi::sceneSchema());
+  mfsi::Simulation sim(cfg);
+  auto after = mfsi::Module::constructionCounts();
+  EXPECT_FALSE(sim.hasMesh());
+  ASSERT_EQ(sim.modules().size(), 1u);
+  EXPECT_EQ(sim.modules()[0]->name(), "bodies");
+  EXPECT_EQ(after["bodies"], before["bodies"] + 1);
+  after.erase("bodies");
+  before.erase("bodies");
+  EXPECT_EQ(after, before) << "a module other than 'bodies' was constructed";
+  EXPECT_EQ(rec.countWithPrefix("mfsi::core::mesh::"), 0) << "a mesh was built for a scene without one";
+  EXPECT_EQ(rec.countWithPrefix("mfsi::fluid::"), 0);
+}

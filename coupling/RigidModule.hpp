@@ -1,0 +1,32 @@
+#pragma once
+/// \file
+/// \brief The `bodies` section as a module of a run: rigid frames on joints and restraints.
+#include "coupling/Module.hpp"
+#include "structure/RigidBodySystem.hpp"
+
+#include <fstream>
+
+namespace mfsi {
+
+class RigidModule final : public Module {
+ public:
+  explicit RigidModule(const RigidSystemOptions& options);
+  void advance(const TimeState& t) override;
+  void addMetrics(std::map<std::string, double>& metrics) const override;
+  void openOutput(const std::string& dir) override;
+  std::vector<std::string> stepColumns() const override;
+  void appendStepValues(std::vector<double>& values) const override;
+
+  RigidBodySystem& system() { return system_; }
+
+ private:
+  RigidBodySystem system_;
+  std::ofstream csv_;
+  double energy0_ = 0.0;
+  double maxEnergyDrift_ = 0.0;
+};
+
+/// Catalogue entry of the `bodies` section.
+ModuleEntry rigidModuleEntry();
+
+}  // namespace mfsi
