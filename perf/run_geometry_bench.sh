@@ -12,11 +12,11 @@ for t in 1 2; do
 import json, sys
 d = json.load(open(sys.argv[1]))
 med = {b["run_name"]: b for b in d["benchmarks"] if b.get("aggregate_name") == "median"}
-stream = next(v for k, v in med.items() if "streamTriad" in k)["GB/s"] / 1e9
+stream = next(v for k, v in med.items() if "streamTriad" in k)["GB/s"]
 print(f"STREAM triad: {stream:.1f} GB/s")
 for k, v in med.items():
     if "Geometry" in k:
-        gbs = v["GB/s"] / 1e9
+        gbs = v["GB/s"]
         print(f"{k}: {v['cells/s']/1e6:.2f} Mcells/s, {gbs:.2f} GB/s = {100*gbs/stream:.1f} % of STREAM")
 PY
 done

@@ -1,0 +1,169 @@
+#pragma once
+/// \file
+/// \brief Plain options of the incompressible ALE finite-volume fluid solver. A config layer fills
+/// these from YAML; the solver never sees the parser.
+#include "core/Types.hpp"
+#include "fluid/FvAssembly.hpp"
+
+#include <array>
+#include <functional>
+#include <map>
+#include <string>
+
+namespace mfsi::fluid {
+
+using Vec3 = std::array<real, 3>;
+
+/// \brief Time discretisation.
+enum class TimeScheme {
+  Steady,  ///< no time derivative; SIMPLE iterations with under-relaxation (`PimpleOptions::relax*`)
+  Euler,   ///< implicit Euler (first order)
+  BDF2,    ///< second-order backward differences, volume-weighted for moving meshes (Euler on step 1)
+};
+
+/// \brief Interpolation of the convected velocity to faces.
+enum class ConvectionScheme {
+  Upwind,         ///< first-order upwind, implicit
+  Linear,         ///< central (linear interpolation), implicit
+  LimitedLinear,  ///< TVD blend of upwind and linear (limiter min(2r, 1)), deferred correction on upwind
+  VanLeer,        ///< TVD van Leer limiter, deferred correction on upwind
+};
+
+/// \brief Cell gradient reconstruction.
+enum class GradientScheme {
+  GaussLinear,   ///< Green-Gauss with linearly interpolated face values
+  LeastSquares,  ///< inverse-distance-weighted least squares over face neighbours and boundary faces
+};
+
+/// \brief Pressure value at walls and other faces with a prescribed velocity (the face flux there
+/// is fixed, so this value only enters the cell pressure gradient and the loads).
+enum class WallPressure {
+  /// p_b = p_P + grad(p)_P . (x_b - x_P) with the latest gradient: consistent for linear pressure
+  /// (hydrostatics, accelerating columns) and second order for the wall loads
+  Extrapolated,
+  /// p_b = p_P: halves the normal gradient in wall cells, a first-order error in those cells
+  ZeroGradient,
+};
+
+/// \brief Kind of a fluid boundary condition on a patch.
+enum class BoundaryType {
+  Auto,           ///< from the mesh patch kind: wall -> Wall, symmetry -> Slip, empty -> Empty, baffle sides -> Wall
+                  ///< with `WallMotion::External`; a plain patch without an entry is an error
+  FixedVelocity,  ///< prescribed velocity (`velocity` x profile x time function); zero-gradient/fixed-flux pressure
+  FlowRate,       ///< prescribed volumetric inflow `flowRate` x time function, along the inward normal, with a profile
+  Wall,           ///< impermeable wall; tangential velocity from `wallMotion`, normal velocity = mesh velocity
+  Slip,           ///< free slip / symmetry plane (moves with the mesh)
+  Empty,          ///< front and back of a one-cell-thick 2D mesh: no flux of anything
+  FixedPressure,  ///< p = pressure x time function, zero-gradient velocity (outflow)
+  Resistance,     ///< p = resistance * q + pressure, q the outflow rate through the patch (explicit in q)
+};
+
+/// \brief Spatial shape of a prescribed velocity or flow rate on a patch.
+enum class Profile {
+  Uniform,    ///< constant over the patch
+  Parabolic,  ///< prod over `parabolicAxes` of 4 s (1 - s), s in [0, 1] across the patch extent, peak 1
+  Function,   ///< `velocityFunction(x, t)` (FixedVelocity only; the time function still multiplies it)
+};
+
+/// \brief Scalar time modulation f(t) of a boundary value.
+struct TimeFunction {
+  enum class Kind {
+    Constant,     ///< f = 1
+    OneMinusCos,  ///< f = 1 - cos(2 pi t / period)
+    CosineRamp,   ///< f = (1 - cos(pi t / period)) / 2 for t < period, then 1
+    Function,     ///< f = fn(t)
+  };
+  Kind kind = Kind::Constant;
+  real period = 1.0;
+  std::function<real(real)> fn;
+
+  /// \brief Value at time t.
+  real operator()(real t) const;
+};
+
+/// \brief Where a wall's tangential velocity comes from.
+enum class WallMotion {
+  Fixed,         ///< `PatchBC::velocity` x time function (zero: no-slip; e.g. a driven lid)
+  MeshVelocity,  ///< the velocity of the mesh nodes of the face (walls that move with the mesh)
+  External,      ///< per-face values given by `FluidSolver::setWallVelocity` (membranes on baffles)
+};
+
+/// \brief Boundary condition of one patch.
+struct PatchBC {
+  BoundaryType type = BoundaryType::Auto;
+  Vec3 velocity{0, 0, 0};  ///< FixedVelocity: value (peak for Parabolic); Wall + Fixed: wall velocity
+  Profile profile = Profile::Uniform;
+  std::array<bool, 3> parabolicAxes{false, false, false};  ///< axes the parabola varies across
+  /// Parabola extent per axis; if min >= max on an axis the patch's bounding box is used.
+  Vec3 parabolicMin{0, 0, 0};
+  Vec3 parabolicMax{0, 0, 0};
+  std::function<Vec3(const Vec3& x, real t)> velocityFunction;  ///< Profile::Function
+  real flowRate = 0;    ///< FlowRate: volumetric inflow [m^3/s] (positive into the domain)
+  real pressure = 0;    ///< FixedPressure: p; Resistance: p0 [Pa]
+  real resistance = 0;  ///< Resistance: C_r [Pa s / m^3]
+  TimeFunction timeFunction;  ///< multiplies the velocity, flow rate or pressure
+  WallMotion wallMotion = WallMotion::Fixed;
+};
+
+/// \brief Preconditioner of the pressure equation's conjugate gradients.
+enum class PressurePreconditioner {
+  Amg,     ///< smoothed-aggregation algebraic multigrid (kernels/Amg.hpp), mesh-independent iterations
+  Jacobi,  ///< diagonal scaling
+};
+
+/// \brief Stopping rule of one linear solve: scaled residual (OpenFOAM's normalisation, see
+/// fluid/LinearSolve.hpp) below `tolerance`, or 2-norm reduced by `relTol`, or `maxIter`.
+struct LinearSolverOptions {
+  real tolerance = 1e-8;
+  real relTol = 0.0;
+  int maxIter = 2000;
+};
+
+/// \brief Pressure-velocity coupling (PIMPLE; with TimeScheme::Steady it is SIMPLE).
+struct PimpleOptions {
+  int nOuterCorrectors = 1;         ///< outer iterations per step (SIMPLE iterations when steady)
+  int nCorrectors = 2;              ///< pressure correctors per outer iteration (PISO)
+  int nNonOrthogonalCorrectors = 0; ///< extra pressure solves for the explicit non-orthogonal correction
+  bool momentumPredictor = true;
+  /// Outer loop stops early when the initial residuals of momentum and pressure drop below this.
+  real outerTolerance = 0.0;
+  real relaxVelocity = 1.0;  ///< implicit under-relaxation of momentum (use ~0.7 when steady)
+  real relaxPressure = 1.0;  ///< explicit under-relaxation of pressure (use ~0.3 when steady)
+  /// Rhie-Chow correction of the time-derivative term (face fluxes remember their own history), so
+  /// results do not depend on dt through the interpolation.
+  bool ddtCorrection = true;
+};
+
+/// \brief All options of `FluidSolver`.
+struct FluidOptions {
+  real density = 1.0;    ///< rho [kg/m^3]
+  real viscosity = 0.01; ///< dynamic viscosity mu [Pa s]
+  Vec3 bodyForce{0, 0, 0};  ///< body acceleration g [m/s^2]
+  TimeScheme timeScheme = TimeScheme::BDF2;
+  ConvectionScheme convection = ConvectionScheme::Linear;
+  GradientScheme gradient = GradientScheme::GaussLinear;
+  WallPressure wallPressure = WallPressure::Extrapolated;
+  ReductionMode reduction = ReductionMode::Gather;
+  PimpleOptions pimple;
+  LinearSolverOptions momentumSolver{1e-10, 0.0, 1000};
+  LinearSolverOptions pressureSolver{1e-10, 0.0, 5000};
+  PressurePreconditioner pressurePreconditioner = PressurePreconditioner::Amg;
+  /// Outer iterations between value refreshes of the pressure preconditioner (it is always
+  /// refreshed at the start of `solve()`). A slightly stale AMG hierarchy is still a good, fixed
+  /// SPD preconditioner, and its refresh costs more than a solve on small meshes. Jacobi is
+  /// refreshed every outer iteration regardless.
+  int pressurePreconditionerRefresh = 10;
+  /// Used only when no boundary fixes the pressure level.
+  lid_t pressureReferenceCell = 0;
+  real pressureReferenceValue = 0;
+  Vec3 initialVelocity{0, 0, 0};
+  real initialPressure = 0;
+  /// Boundary condition per patch name (patches of kind wall/symmetry/empty/baffle may be omitted).
+  std::map<std::string, PatchBC> boundaries;
+};
+
+const char* toString(TimeScheme s);
+const char* toString(ConvectionScheme s);
+const char* toString(BoundaryType t);
+
+}  // namespace mfsi::fluid

@@ -1,0 +1,748 @@
+#include "fluid/FluidSolver.hpp"
+
+#include "core/Error.hpp"
+#include "fluid/MeshFlux.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+namespace mfsi::fluid {
+
+namespace {
+
+// TVD limiters in r-form (OpenFOAM's r = 2 d.grad(phi_C) / (phi_D - phi_C) - 1).
+KOKKOS_INLINE_FUNCTION real limiter(ConvectionScheme s, real r) {
+  if (s == ConvectionScheme::LimitedLinear) {
+    const real v = 2.0 * r;
+    return v < 0.0 ? 0.0 : (v > 1.0 ? 1.0 : v);
+  }
+  const real ar = kmath::fabs(r);
+  return (r + ar) / (1.0 + ar);  // van Leer
+}
+
+}  // namespace
+
+FluidSolver::FluidSolver(const HexMesh& mesh, const FluidOptions& options)
+    : mesh_(mesh),
+      opt_(options),
+      nCells_(mesh.nCells()),
+      nFaces_(mesh.nFaces()),
+      nIn_(mesh.nInternalFaces()),
+      nB_(mesh.nBoundaryFaces()) {
+  MFSI_CHECK(mesh.nOwnedCells() == mesh.nCells(), "fluid: the fluid solver runs on one rank (mesh has ghost cells)");
+  MFSI_CHECK(opt_.density > 0, "fluid: density must be positive (key fluid.density)");
+  MFSI_CHECK(opt_.viscosity >= 0, "fluid: viscosity must be non-negative (key fluid.viscosity)");
+  MFSI_CHECK(opt_.pimple.nOuterCorrectors >= 1, "fluid: nOuterCorrectors must be >= 1");
+  MFSI_CHECK(opt_.pimple.nCorrectors >= 1, "fluid: nCorrectors must be >= 1");
+  MFSI_CHECK(opt_.pimple.nNonOrthogonalCorrectors >= 0, "fluid: nNonOrthogonalCorrectors must be >= 0");
+  MFSI_CHECK(opt_.pimple.relaxVelocity > 0 && opt_.pimple.relaxVelocity <= 1,
+             "fluid: relaxVelocity must be in (0, 1]");
+  MFSI_CHECK(opt_.pimple.relaxPressure > 0 && opt_.pimple.relaxPressure <= 1,
+             "fluid: relaxPressure must be in (0, 1]");
+  MFSI_CHECK(opt_.pressureReferenceCell >= 0 && opt_.pressureReferenceCell < nCells_,
+             "fluid: pressureReferenceCell " << opt_.pressureReferenceCell << " is not a cell of the mesh");
+  ScopedRegion region("mfsi::fluid::setup");
+
+  geo_ = allocateGeometry(mesh);
+  fd_ = allocateFaceData(mesh);
+  sparsity_ = buildSparsity(mesh);
+  Au_ = makeMatrix(sparsity_, "mfsi::fluid::momentum::matrix");
+  Ap_ = makeMatrix(sparsity_, "mfsi::fluid::pressure::matrix");
+  fcU_ = allocateFaceCoefficients(mesh, "mfsi::fluid::momentum::face");
+  fcP_ = allocateFaceCoefficients(mesh, "mfsi::fluid::pressure::face");
+  bc_ = BoundaryConditions(mesh, opt_);
+  linear_ = LinearSolver(nCells_, opt_.pressurePreconditioner);
+
+  U_ = Real3View("mfsi::fluid::U", nCells_);
+  U0_ = Real3View("mfsi::fluid::U0", nCells_);
+  U00_ = Real3View("mfsi::fluid::U00", nCells_);
+  p_ = RealView("mfsi::fluid::p", nCells_);
+  pPrev_ = RealView("mfsi::fluid::pPrevIter", nCells_);
+  V0_ = RealView("mfsi::fluid::V0", nCells_);
+  V00_ = RealView("mfsi::fluid::V00", nCells_);
+  HbyA_ = Real3View("mfsi::fluid::HbyA", nCells_);
+  gradP_ = Real3View("mfsi::fluid::gradP", nCells_);
+  rhsU_ = Real3View("mfsi::fluid::momentum::rhs", nCells_);
+  bodyU_ = Real3View("mfsi::fluid::momentum::source", nCells_);
+  gradU_ = Tensor3View("mfsi::fluid::gradU", nCells_);
+  rAU_ = RealView("mfsi::fluid::rAU", nCells_);
+  diagU_ = RealView("mfsi::fluid::momentum::diag", nCells_);
+  cellDiag_ = RealView("mfsi::fluid::cellDiag", nCells_);
+  rhsP_ = RealView("mfsi::fluid::pressure::rhs", nCells_);
+  x_ = RealView("mfsi::fluid::solveX", nCells_);
+  b_ = RealView("mfsi::fluid::solveB", nCells_);
+  phi_ = RealView("mfsi::fluid::phi", nFaces_);
+  meshPhi_ = RealView("mfsi::fluid::meshPhi", nFaces_);
+  phiHbyA_ = RealView("mfsi::fluid::phiHbyA", nFaces_);
+  dphi_ = RealView("mfsi::fluid::ddtCorr::dphi", nFaces_);
+  dphi0_ = RealView("mfsi::fluid::ddtCorr::dphi0", nFaces_);
+  dphi00_ = RealView("mfsi::fluid::ddtCorr::dphi00", nFaces_);
+  sweptNew_ = RealView("mfsi::fluid::sweptVolume", nFaces_);
+  sweptOld_ = RealView("mfsi::fluid::sweptVolume0", nFaces_);
+  fluxP_ = RealView("mfsi::fluid::pressure::faceFlux", nFaces_);
+  fluxU_ = Real3View("mfsi::fluid::momentum::faceFlux", nFaces_);
+  Ub_ = Real3View("mfsi::fluid::Ub", nB_);
+  faceMeshVel_ = Real3View("mfsi::fluid::faceMeshVelocity", nB_);
+  pb_ = RealView("mfsi::fluid::pb", nB_);
+  points0_ = Real3View("mfsi::fluid::points0", mesh.nNodes());
+
+  updateGeometry();
+  Kokkos::deep_copy(exec_, points0_, mesh.points());
+  Kokkos::deep_copy(exec_, V0_, geo_.cellVolume);
+  Kokkos::deep_copy(exec_, V00_, geo_.cellVolume);
+
+  const real u0x = opt_.initialVelocity[0], u0y = opt_.initialVelocity[1], u0z = opt_.initialVelocity[2];
+  auto U = U_;
+  Kokkos::parallel_for(
+      "mfsi::fluid::init", RangePolicy(exec_, 0, nCells_), KOKKOS_LAMBDA(lid_t c) {
+        U(c, 0) = u0x;
+        U(c, 1) = u0y;
+        U(c, 2) = u0z;
+      });
+  Kokkos::deep_copy(exec_, p_, opt_.initialPressure);
+  computeTimeCoefficients();
+  bc_.update(exec_, 0.0, geo_, faceMeshVel_);
+  setVelocity(U_);
+  updatePressureGradient();
+  exec_.fence();
+}
+
+// ------------------------------------------------------------------------------------------------
+// Time levels and mesh motion
+// ------------------------------------------------------------------------------------------------
+
+void FluidSolver::updateGeometry() {
+  computeGeometry(exec_, mesh_, geo_);
+  computeFaceData(exec_, mesh_, geo_, fd_);
+}
+
+void FluidSolver::computeTimeCoefficients() {
+  switch (opt_.timeScheme) {
+    case TimeScheme::Steady: c1_ = c0_ = c00_ = 0.0; break;
+    case TimeScheme::Euler:
+      c1_ = c0_ = 1.0;
+      c00_ = 0.0;
+      break;
+    case TimeScheme::BDF2:
+      if (bdf2Active_) {
+        // Variable-step BDF2: d/dt ~ (c1 y^{n+1} - c0 y^n + c00 y^{n-1}) / dt.
+        c1_ = 1.0 + dt_ / (dt_ + dt0_);
+        c00_ = dt_ * dt_ / (dt0_ * (dt_ + dt0_));
+        c0_ = c1_ + c00_;
+      } else {
+        c1_ = c0_ = 1.0;
+        c00_ = 0.0;
+      }
+      break;
+  }
+}
+
+void FluidSolver::computeMeshFlux() {
+  // phi^m = (c1 dV^{n+1} - c00 dV^n) / dt: summed over a cell's faces this is exactly the discrete
+  // time derivative of its volume with the same weights as the momentum time term.
+  const real c1 = c1_, c00 = c00_, rdt = 1.0 / dt_;
+  const bool steady = opt_.timeScheme == TimeScheme::Steady;
+  auto mp = meshPhi_;
+  ConstRealView sn = sweptNew_, so = sweptOld_;
+  Kokkos::parallel_for(
+      "mfsi::fluid::meshFlux", RangePolicy(exec_, 0, nFaces_),
+      KOKKOS_LAMBDA(lid_t f) { mp(f) = steady ? 0.0 : (c1 * sn(f) - c00 * so(f)) * rdt; });
+}
+
+void FluidSolver::beginStep(real t, real dt) {
+  MFSI_CHECK(dt > 0, "fluid: time step must be positive, got " << dt);
+  ScopedRegion region("mfsi::fluid::beginStep");
+  if (nSteps_ > 0) {
+    dt0_ = dt_;
+    Kokkos::deep_copy(exec_, U00_, U0_);
+    Kokkos::deep_copy(exec_, V00_, V0_);
+    Kokkos::deep_copy(exec_, sweptOld_, sweptNew_);
+    Kokkos::deep_copy(exec_, dphi00_, dphi0_);
+    bdf2Active_ = opt_.timeScheme == TimeScheme::BDF2;
+  }
+  Kokkos::deep_copy(exec_, U0_, U_);
+  Kokkos::deep_copy(exec_, V0_, geo_.cellVolume);
+  Kokkos::deep_copy(exec_, dphi0_, dphi_);
+  Kokkos::deep_copy(exec_, sweptNew_, 0.0);
+  Kokkos::deep_copy(exec_, faceMeshVel_, 0.0);
+  Kokkos::deep_copy(exec_, points0_, mesh_.points());
+  t_ = t;
+  dt_ = dt;
+  ++nSteps_;
+  computeTimeCoefficients();
+  computeMeshFlux();
+  bc_.update(exec_, t_ + dt_, geo_, faceMeshVel_);
+  updateBoundaryVelocity();
+}
+
+void FluidSolver::moveMesh(const ConstReal3View& newPoints) {
+  ScopedRegion region("mfsi::fluid::moveMesh");
+  MFSI_CHECK(static_cast<lid_t>(newPoints.extent(0)) == mesh_.nNodes(),
+             "fluid: moveMesh: got " << newPoints.extent(0) << " points for a mesh of " << mesh_.nNodes());
+  Real3View pts = mesh_.points();
+  if (pts.data() != newPoints.data()) Kokkos::deep_copy(exec_, pts, newPoints);
+  sweptVolumes(exec_, mesh_, points0_, pts, sweptNew_);
+  boundaryFaceMeshVelocity(exec_, mesh_, points0_, pts, dt_, faceMeshVel_);
+  updateGeometry();
+  computeMeshFlux();
+  bc_.update(exec_, t_ + dt_, geo_, faceMeshVel_);
+  updateBoundaryVelocity();
+}
+
+void FluidSolver::setWallVelocity(const std::string& name, const ConstReal3View& faceVelocity) {
+  bc_.setWallVelocity(name, faceVelocity);
+  updateBoundaryVelocity();
+}
+
+void FluidSolver::setVelocity(const ConstReal3View& u) {
+  if (u.data() != U_.data()) Kokkos::deep_copy(exec_, U_, u);
+  updateBoundaryVelocity();
+  // Fluxes consistent with the new field: interpolated on internal faces, u_b . S on the boundary.
+  ConstIndexView own = mesh_.faceOwner(), nei = mesh_.faceNeighbour();
+  ConstReal3View sf = geo_.faceArea;
+  ConstRealView w = fd_.weight;
+  ConstReal3View U = U_, Ub = Ub_;
+  ConstIndexView kind = bc_.kind();
+  auto phi = phi_;
+  auto mp = meshPhi_;
+  const lid_t nIn = nIn_;
+  Kokkos::parallel_for(
+      "mfsi::fluid::initFlux", RangePolicy(exec_, 0, nFaces_), KOKKOS_LAMBDA(lid_t f) {
+        real s = 0;
+        if (f < nIn) {
+          for (int k = 0; k < 3; ++k) s += (w(f) * U(own(f), k) + (1.0 - w(f)) * U(nei(f), k)) * sf(f, k);
+        } else {
+          const int kd = kind(f - nIn);
+          if (kd == kFaceWall || kd == kFaceSlip || kd == kFaceEmpty) {
+            s = mp(f);
+          } else {
+            for (int k = 0; k < 3; ++k) s += Ub(f - nIn, k) * sf(f, k);
+          }
+        }
+        phi(f) = s;
+      });
+  Kokkos::deep_copy(exec_, dphi_, 0.0);
+}
+
+void FluidSolver::setPressure(const ConstRealView& p) {
+  if (p.data() != p_.data()) Kokkos::deep_copy(exec_, p_, p);
+  updatePressureGradient();
+}
+
+// ------------------------------------------------------------------------------------------------
+// Boundary values
+// ------------------------------------------------------------------------------------------------
+
+void FluidSolver::updateBoundaryVelocity() {
+  ConstIndexView own = mesh_.faceOwner();
+  ConstIndexView kind = bc_.kind();
+  ConstReal3View bv = bc_.velocity();
+  ConstReal3View sf = geo_.faceArea;
+  ConstRealView sm = geo_.faceAreaMag;
+  ConstReal3View U = U_;
+  ConstRealView mp = meshPhi_;
+  auto Ub = Ub_;
+  auto phi = phi_;
+  const lid_t nIn = nIn_;
+  Kokkos::parallel_for(
+      "mfsi::fluid::bc::velocity", RangePolicy(exec_, 0, nB_), KOKKOS_LAMBDA(lid_t b) {
+        const lid_t f = b + nIn;
+        const lid_t o = own(f);
+        const real mag = sm(f);
+        const real n[3] = {sf(f, 0) / mag, sf(f, 1) / mag, sf(f, 2) / mag};
+        switch (kind(b)) {
+          case kFaceVelocity: {
+            real s = 0;
+            for (int k = 0; k < 3; ++k) {
+              Ub(b, k) = bv(b, k);
+              s += bv(b, k) * sf(f, k);
+            }
+            phi(f) = s;
+            break;
+          }
+          case kFaceWall: {
+            // Tangential velocity as prescribed, normal velocity that of the mesh: no flow through.
+            const real un = mp(f) / mag;
+            const real uwn = bv(b, 0) * n[0] + bv(b, 1) * n[1] + bv(b, 2) * n[2];
+            for (int k = 0; k < 3; ++k) Ub(b, k) = bv(b, k) + n[k] * (un - uwn);
+            phi(f) = mp(f);
+            break;
+          }
+          case kFaceSlip: {
+            const real un = mp(f) / mag;
+            const real upn = U(o, 0) * n[0] + U(o, 1) * n[1] + U(o, 2) * n[2];
+            for (int k = 0; k < 3; ++k) Ub(b, k) = U(o, k) + n[k] * (un - upn);
+            phi(f) = mp(f);
+            break;
+          }
+          case kFaceEmpty:
+            for (int k = 0; k < 3; ++k) Ub(b, k) = U(o, k);
+            phi(f) = mp(f);
+            break;
+          default:  // pressure: zero-gradient velocity, flux from the pressure equation
+            for (int k = 0; k < 3; ++k) Ub(b, k) = U(o, k);
+            break;
+        }
+      });
+}
+
+void FluidSolver::updateBoundaryPressure() {
+  ConstIndexView own = mesh_.faceOwner();
+  ConstIndexView kind = bc_.kind();
+  ConstRealView bp = bc_.pressure();
+  ConstRealView p = p_;
+  ConstReal3View gp = gradP_, fc = geo_.faceCentroid, cc = geo_.cellCentroid;
+  const bool extrapolate = opt_.wallPressure == WallPressure::Extrapolated;
+  auto pb = pb_;
+  const lid_t nIn = nIn_;
+  Kokkos::parallel_for(
+      "mfsi::fluid::bc::pressure", RangePolicy(exec_, 0, nB_), KOKKOS_LAMBDA(lid_t b) {
+        const lid_t f = b + nIn, o = own(f);
+        const int kd = kind(b);
+        if (kd == kFacePressure) {
+          pb(b) = bp(b);
+        } else if (kd == kFaceEmpty || !extrapolate) {
+          pb(b) = p(o);
+        } else {
+          real s = p(o);
+          for (int k = 0; k < 3; ++k) s += gp(o, k) * (fc(f, k) - cc(o, k));
+          pb(b) = s;
+        }
+      });
+}
+
+void FluidSolver::updatePressureGradient() {
+  // The extrapolated wall values depend on the gradient they feed; two passes contract the lag by
+  // a factor of four (each pass halves it) and the outer iterations converge it.
+  for (int pass = 0; pass < 2; ++pass) {
+    updateBoundaryPressure();
+    computePressureGradient();
+  }
+}
+
+void FluidSolver::computeVelocityGradient() {
+  cellGradient(exec_, opt_.gradient, mesh_, geo_, fd_, U_, Ub_, gradU_);
+}
+
+void FluidSolver::computePressureGradient() {
+  cellGradient(exec_, opt_.gradient, mesh_, geo_, fd_, p_, pb_, gradP_);
+}
+
+// ------------------------------------------------------------------------------------------------
+// Momentum
+// ------------------------------------------------------------------------------------------------
+
+void FluidSolver::assembleMomentum() {
+  ScopedRegion region("mfsi::fluid::momentum::assemble");
+  const real rho = opt_.density, mu = opt_.viscosity;
+  const ConvectionScheme scheme = opt_.convection;
+  const bool implicitLinear = scheme == ConvectionScheme::Linear;
+  const bool limited = scheme == ConvectionScheme::LimitedLinear || scheme == ConvectionScheme::VanLeer;
+  const lid_t nIn = nIn_;
+  ConstIndexView own = mesh_.faceOwner(), nei = mesh_.faceNeighbour();
+  ConstIndexView kind = bc_.kind();
+  ConstRealView phi = phi_, mp = meshPhi_, w = fd_.weight, dc = fd_.deltaCoeff;
+  ConstReal3View kv = fd_.nonOrth, cc = geo_.cellCentroid, U = U_, Ub = Ub_;
+  ConstTensor3View G = gradU_;
+  auto od = fcU_.ownerDiag, nd = fcU_.neighbourDiag, up = fcU_.upper, lo = fcU_.lower;
+  auto flux = fluxU_;
+  Kokkos::parallel_for(
+      "mfsi::fluid::momentum::faceCoefficients", RangePolicy(exec_, 0, nFaces_), KOKKOS_LAMBDA(lid_t f) {
+        const real F = rho * (phi(f) - mp(f));  // mass flux relative to the moving face
+        if (f < nIn) {
+          const lid_t o = own(f), n = nei(f);
+          const real wf = w(f), D = mu * dc(f);
+          if (implicitLinear) {
+            od(f) = F * wf + D;
+            up(f) = F * (1.0 - wf) - D;
+            nd(f) = -F * (1.0 - wf) + D;
+            lo(f) = -F * wf - D;
+          } else {
+            const real Fp = F > 0 ? F : 0.0, Fm = F < 0 ? F : 0.0;
+            od(f) = Fp + D;
+            up(f) = Fm - D;
+            nd(f) = -Fm + D;
+            lo(f) = -Fp - D;
+          }
+          const lid_t C = F >= 0 ? o : n, Dn = F >= 0 ? n : o;
+          for (int j = 0; j < 3; ++j) {
+            // Explicit non-orthogonal part of the diffusive flux.
+            real corr = 0;
+            for (int i = 0; i < 3; ++i) corr += kv(f, i) * (wf * G(o, i, j) + (1.0 - wf) * G(n, i, j));
+            real fl = -mu * corr;
+            if (limited) {
+              // Deferred correction: implicit upwind plus F (phi_TVD - phi_upwind) lagged.
+              const real phiC = U(C, j), phiD = U(Dn, j);
+              const real lin = wf * U(o, j) + (1.0 - wf) * U(n, j);
+              const real diff = phiD - phiC;
+              real psi = 1.0;
+              if (kmath::fabs(diff) > 1e-300) {
+                real dg = 0;
+                for (int i = 0; i < 3; ++i) dg += (cc(Dn, i) - cc(C, i)) * G(C, i, j);
+                psi = limiter(scheme, 2.0 * dg / diff - 1.0);
+              }
+              fl += F * psi * (lin - phiC);
+            }
+            flux(f, j) = fl;
+          }
+        } else {
+          const lid_t b = f - nIn;
+          up(f) = lo(f) = nd(f) = 0.0;
+          const real D = mu * dc(f);
+          switch (kind(b)) {
+            case kFaceVelocity:
+            case kFaceWall:
+              od(f) = D;
+              for (int j = 0; j < 3; ++j) flux(f, j) = (F - D) * Ub(b, j);
+              break;
+            case kFaceSlip:
+              od(f) = D;
+              for (int j = 0; j < 3; ++j) flux(f, j) = -D * Ub(b, j);
+              break;
+            case kFaceEmpty:
+              od(f) = 0.0;
+              for (int j = 0; j < 3; ++j) flux(f, j) = 0.0;
+              break;
+            default: {  // pressure outlet: zero-gradient, outflow implicit, backflow lagged
+              od(f) = F > 0 ? F : 0.0;
+              const real Fm = F < 0 ? F : 0.0;
+              for (int j = 0; j < 3; ++j) flux(f, j) = Fm * Ub(b, j);
+              break;
+            }
+          }
+        }
+      });
+
+  // Time term and body force per cell.
+  const bool steady = opt_.timeScheme == TimeScheme::Steady;
+  const real rdt = 1.0 / dt_, c1 = c1_, c0 = c0_, c00 = c00_;
+  const real gx = opt_.bodyForce[0], gy = opt_.bodyForce[1], gz = opt_.bodyForce[2];
+  ConstRealView V = geo_.cellVolume, V0 = V0_, V00 = V00_;
+  ConstReal3View U0 = U0_, U00 = U00_;
+  auto cd = cellDiag_;
+  auto rhs = rhsU_;
+  Kokkos::parallel_for(
+      "mfsi::fluid::momentum::cellTerms", RangePolicy(exec_, 0, nCells_), KOKKOS_LAMBDA(lid_t c) {
+        cd(c) = steady ? 0.0 : rho * c1 * V(c) * rdt;
+        const real g[3] = {gx, gy, gz};
+        for (int j = 0; j < 3; ++j) {
+          real s = rho * V(c) * g[j];
+          if (!steady) s += rho * (c0 * V0(c) * U0(c, j) - c00 * V00(c) * U00(c, j)) * rdt;
+          rhs(c, j) = s;
+        }
+      });
+  divergence<3>(exec_, mesh_, fluxU_, rhsU_, opt_.reduction, /*accumulate=*/true, /*sign=*/-1.0);
+  assembleMatrix(exec_, mesh_, sparsity_, fcU_, cellDiag_, Au_, opt_.reduction);
+
+  // Implicit under-relaxation: a_P -> a_P / alpha, source += (a_P / alpha - a_P) u_prev.
+  const real alpha = opt_.pimple.relaxVelocity;
+  ConstIndexView di = Au_.diagIdx;
+  auto vals = Au_.values;
+  auto diag = diagU_;
+  Kokkos::parallel_for(
+      "mfsi::fluid::momentum::relax", RangePolicy(exec_, 0, nCells_), KOKKOS_LAMBDA(lid_t c) {
+        const real a = vals(di(c));
+        const real ar = a / alpha;
+        vals(di(c)) = ar;
+        diag(c) = ar;
+        for (int j = 0; j < 3; ++j) rhs(c, j) += (ar - a) * U(c, j);
+      });
+}
+
+void FluidSolver::computeHbyA() {
+  // H = b - sum_N a_PN u_N (all but the pressure gradient); u = HbyA - rAU grad p, rAU = V / a_P.
+  ConstIndexView rp = Au_.rowPtr, ci = Au_.colIdx, di = Au_.diagIdx;
+  ConstRealView vals = Au_.values, diag = diagU_, V = geo_.cellVolume;
+  ConstReal3View U = U_, rhs = rhsU_;
+  auto H = HbyA_;
+  auto rAU = rAU_;
+  Kokkos::parallel_for(
+      "mfsi::fluid::momentum::HbyA", RangePolicy(exec_, 0, nCells_), KOKKOS_LAMBDA(lid_t c) {
+        real h[3] = {rhs(c, 0), rhs(c, 1), rhs(c, 2)};
+        for (lid_t k = rp(c); k < rp(c + 1); ++k) {
+          if (k == di(c)) continue;
+          const lid_t n = ci(k);
+          for (int j = 0; j < 3; ++j) h[j] -= vals(k) * U(n, j);
+        }
+        for (int j = 0; j < 3; ++j) H(c, j) = h[j] / diag(c);
+        rAU(c) = V(c) / diag(c);
+      });
+}
+
+// ------------------------------------------------------------------------------------------------
+// Pressure
+// ------------------------------------------------------------------------------------------------
+
+void FluidSolver::computePhiHbyA() {
+  const lid_t nIn = nIn_;
+  const bool ddt = opt_.pimple.ddtCorrection && opt_.timeScheme != TimeScheme::Steady;
+  const real rho = opt_.density, rdt = 1.0 / dt_, c0 = c0_, c00 = c00_;
+  ConstIndexView own = mesh_.faceOwner(), nei = mesh_.faceNeighbour();
+  ConstIndexView kind = bc_.kind();
+  ConstRealView w = fd_.weight, rAU = rAU_, phi = phi_, d0 = dphi0_, d00 = dphi00_;
+  ConstReal3View sf = geo_.faceArea, H = HbyA_;
+  auto phiH = phiHbyA_;
+  Kokkos::parallel_for(
+      "mfsi::fluid::pressure::phiHbyA", RangePolicy(exec_, 0, nFaces_), KOKKOS_LAMBDA(lid_t f) {
+        const lid_t o = own(f);
+        if (f < nIn) {
+          const lid_t n = nei(f);
+          const real wf = w(f);
+          real s = 0;
+          for (int k = 0; k < 3; ++k) s += (wf * H(o, k) + (1.0 - wf) * H(n, k)) * sf(f, k);
+          if (ddt) {
+            // Rhie-Chow consistent with the time term: the old-time part of H enters through the old
+            // face fluxes rather than the interpolated old cell velocities.
+            const real rAUf = wf * rAU(o) + (1.0 - wf) * rAU(n);
+            s += rAUf * rho * (c0 * d0(f) - c00 * d00(f)) * rdt;
+          }
+          phiH(f) = s;
+        } else {
+          if (kind(f - nIn) == kFacePressure) {
+            real hs = 0;
+            for (int k = 0; k < 3; ++k) hs += H(o, k) * sf(f, k);
+            phiH(f) = hs;
+          } else {
+            phiH(f) = phi(f);  // prescribed flux
+          }
+        }
+      });
+}
+
+void FluidSolver::assemblePressure() {
+  ScopedRegion region("mfsi::fluid::pressure::assemble");
+  const lid_t nIn = nIn_;
+  ConstIndexView own = mesh_.faceOwner(), nei = mesh_.faceNeighbour();
+  ConstIndexView kind = bc_.kind();
+  ConstRealView w = fd_.weight, dc = fd_.deltaCoeff, rAU = rAU_, phiH = phiHbyA_, pb = pb_;
+  ConstReal3View kv = fd_.nonOrth, gp = gradP_;
+  auto od = fcP_.ownerDiag, nd = fcP_.neighbourDiag, up = fcP_.upper, lo = fcP_.lower;
+  auto flux = fluxP_;
+  Kokkos::parallel_for(
+      "mfsi::fluid::pressure::faceCoefficients", RangePolicy(exec_, 0, nFaces_), KOKKOS_LAMBDA(lid_t f) {
+        const lid_t o = own(f);
+        if (f < nIn) {
+          const lid_t n = nei(f);
+          const real wf = w(f);
+          const real rAUf = wf * rAU(o) + (1.0 - wf) * rAU(n);
+          const real coef = rAUf * dc(f);
+          od(f) = nd(f) = coef;
+          up(f) = lo(f) = -coef;
+          real corr = 0;
+          for (int i = 0; i < 3; ++i) corr += kv(f, i) * (wf * gp(o, i) + (1.0 - wf) * gp(n, i));
+          flux(f) = phiH(f) - rAUf * corr;
+        } else {
+          up(f) = lo(f) = nd(f) = 0.0;
+          if (kind(f - nIn) == kFacePressure) {
+            const real coef = rAU(o) * dc(f);
+            od(f) = coef;
+            flux(f) = phiH(f) - coef * pb(f - nIn);
+          } else {
+            od(f) = 0.0;
+            flux(f) = phiH(f);
+          }
+        }
+      });
+  Kokkos::deep_copy(exec_, cellDiag_, 0.0);
+  assembleMatrix(exec_, mesh_, sparsity_, fcP_, cellDiag_, Ap_, opt_.reduction);
+  divergence<1>(exec_, mesh_, fluxP_, rhsP_, opt_.reduction, /*accumulate=*/false, /*sign=*/-1.0);
+  if (!bc_.fixesPressureLevel()) {
+    // No boundary sets the level: doubling one diagonal entry (and adding the matching source)
+    // pins p at the reference cell without changing the other equations.
+    const lid_t ref = opt_.pressureReferenceCell;
+    const real pRef = opt_.pressureReferenceValue;
+    ConstIndexView di = Ap_.diagIdx;
+    auto vals = Ap_.values;
+    auto rhs = rhsP_;
+    Kokkos::parallel_for(
+        "mfsi::fluid::pressure::reference", RangePolicy(exec_, 0, 1), KOKKOS_LAMBDA(lid_t) {
+          const real a = vals(di(ref));
+          vals(di(ref)) = 2.0 * a;
+          rhs(ref) += a * pRef;
+        });
+  }
+}
+
+void FluidSolver::correctFluxAndVelocity() {
+  ScopedRegion region("mfsi::fluid::correct");
+  const lid_t nIn = nIn_;
+  {
+    ConstIndexView own = mesh_.faceOwner(), nei = mesh_.faceNeighbour();
+    ConstIndexView kind = bc_.kind();
+    ConstRealView w = fd_.weight, dc = fd_.deltaCoeff, rAU = rAU_, fl = fluxP_, p = p_;
+    auto phi = phi_;
+    // Face fluxes from the pressure just solved (before any relaxation), with the same
+    // non-orthogonal correction that was in the matrix source: sum_f phi_f = 0 to solver tolerance.
+    Kokkos::parallel_for(
+        "mfsi::fluid::pressure::flux", RangePolicy(exec_, 0, nFaces_), KOKKOS_LAMBDA(lid_t f) {
+          const lid_t o = own(f);
+          if (f < nIn) {
+            const lid_t n = nei(f);
+            const real rAUf = w(f) * rAU(o) + (1.0 - w(f)) * rAU(n);
+            phi(f) = fl(f) - rAUf * dc(f) * (p(n) - p(o));
+          } else if (kind(f - nIn) == kFacePressure) {
+            phi(f) = fl(f) + rAU(o) * dc(f) * p(o);
+          }
+        });
+  }
+  const real ap = opt_.pimple.relaxPressure;
+  if (ap < 1.0) {
+    auto p = p_;
+    ConstRealView pp = pPrev_;
+    Kokkos::parallel_for(
+        "mfsi::fluid::pressure::relax", RangePolicy(exec_, 0, nCells_),
+        KOKKOS_LAMBDA(lid_t c) { p(c) = pp(c) + ap * (p(c) - pp(c)); });
+  }
+  updatePressureGradient();
+  {
+    ConstReal3View H = HbyA_, gp = gradP_;
+    ConstRealView rAU = rAU_;
+    auto U = U_;
+    Kokkos::parallel_for(
+        "mfsi::fluid::momentum::correct", RangePolicy(exec_, 0, nCells_), KOKKOS_LAMBDA(lid_t c) {
+          for (int j = 0; j < 3; ++j) U(c, j) = H(c, j) - rAU(c) * gp(c, j);
+        });
+  }
+  updateBoundaryVelocity();
+}
+
+void FluidSolver::storeDdtCorrection() {
+  ConstIndexView own = mesh_.faceOwner(), nei = mesh_.faceNeighbour();
+  ConstRealView w = fd_.weight, phi = phi_;
+  ConstReal3View sf = geo_.faceArea, U = U_;
+  auto d = dphi_;
+  const lid_t nIn = nIn_;
+  Kokkos::parallel_for(
+      "mfsi::fluid::ddtCorr::store", RangePolicy(exec_, 0, nFaces_), KOKKOS_LAMBDA(lid_t f) {
+        if (f < nIn) {
+          real s = 0;
+          for (int k = 0; k < 3; ++k) s += (w(f) * U(own(f), k) + (1.0 - w(f)) * U(nei(f), k)) * sf(f, k);
+          d(f) = phi(f) - s;
+        } else {
+          d(f) = 0.0;
+        }
+      });
+}
+
+real FluidSolver::continuityMax(real& sum) {
+  divergence<1>(exec_, mesh_, phi_, b_, opt_.reduction);
+  ConstRealView div = b_, V = geo_.cellVolume;
+  real mx = 0;
+  sum = 0;
+  Kokkos::parallel_reduce(
+      "mfsi::fluid::continuity", RangePolicy(exec_, 0, nCells_),
+      KOKKOS_LAMBDA(lid_t c, real & m, real & s) {
+        const real a = kmath::fabs(div(c));
+        const real r = a / V(c);
+        m = r > m ? r : m;
+        s += a;
+      },
+      Kokkos::Max<real>(mx), sum);
+  return mx;
+}
+
+bool FluidSolver::fieldsFinite() {
+  ConstReal3View U = U_;
+  ConstRealView p = p_;
+  real s = 0;
+  Kokkos::parallel_reduce(
+      "mfsi::fluid::finiteCheck", RangePolicy(exec_, 0, nCells_),
+      KOKKOS_LAMBDA(lid_t c, real & acc) {
+        acc += kmath::fabs(U(c, 0)) + kmath::fabs(U(c, 1)) + kmath::fabs(U(c, 2)) + kmath::fabs(p(c));
+      },
+      s);
+  return std::isfinite(s);
+}
+
+// ------------------------------------------------------------------------------------------------
+// PIMPLE
+// ------------------------------------------------------------------------------------------------
+
+StepResult FluidSolver::solve() {
+  ScopedRegion region("mfsi::fluid::solve");
+  StepResult res;
+  const auto& pim = opt_.pimple;
+  ConstRealView V = geo_.cellVolume;
+  for (int outer = 0; outer < pim.nOuterCorrectors; ++outer) {
+    updateBoundaryVelocity();
+    computeVelocityGradient();
+    assembleMomentum();
+    updatePressureGradient();
+    real momRes = 0;
+    if (pim.momentumPredictor) {
+      ScopedRegion r2("mfsi::fluid::momentum::solve");
+      linear_.momentumMatrixChanged(exec_, Au_);
+      for (int j = 0; j < 3; ++j) {
+        auto x = x_, b = b_;
+        auto U = U_;
+        ConstReal3View rhs = rhsU_, gp = gradP_;
+        Kokkos::parallel_for(
+            "mfsi::fluid::momentum::rhsComponent", RangePolicy(exec_, 0, nCells_), KOKKOS_LAMBDA(lid_t c) {
+              b(c) = rhs(c, j) - V(c) * gp(c, j);
+              x(c) = U(c, j);
+            });
+        const auto st = linear_.solveMomentum(exec_, Au_, b_, x_, opt_.momentumSolver);
+        momRes = std::max(momRes, st.initialResidual);
+        res.momentumIterations += st.iterations;
+        if (st.breakdown) res.ok = false;
+        Kokkos::parallel_for(
+            "mfsi::fluid::momentum::storeComponent", RangePolicy(exec_, 0, nCells_),
+            KOKKOS_LAMBDA(lid_t c) { U(c, j) = x(c); });
+      }
+      updateBoundaryVelocity();
+    }
+    real pRes = -1;
+    for (int corr = 0; corr < pim.nCorrectors; ++corr) {
+      computeHbyA();
+      computePhiHbyA();
+      bc_.updateResistance(exec_, phi_);
+      Kokkos::deep_copy(exec_, pPrev_, p_);
+      for (int no = 0; no <= pim.nNonOrthogonalCorrectors; ++no) {
+        updatePressureGradient();
+        assemblePressure();
+        ScopedRegion r3("mfsi::fluid::pressure::solve");
+        // rAU, hence the matrix, is the same for every corrector of one outer iteration.
+        const int refresh = opt_.pressurePreconditioner == PressurePreconditioner::Jacobi
+                                ? 1
+                                : std::max(1, opt_.pressurePreconditionerRefresh);
+        if (corr == 0 && no == 0 && outer % refresh == 0) linear_.pressureMatrixChanged(exec_, Ap_);
+        const auto st = linear_.solvePressure(exec_, Ap_, rhsP_, p_, opt_.pressureSolver);
+        if (pRes < 0) pRes = st.initialResidual;
+        res.pressureIterations += st.iterations;
+        if (st.breakdown) res.ok = false;
+      }
+      correctFluxAndVelocity();
+    }
+    res.outerIterations = outer + 1;
+    if (outer == 0) {
+      res.momentumResidual = momRes;
+      res.pressureResidual = pRes;
+    }
+    res.finalMomentumResidual = momRes;
+    res.finalPressureResidual = pRes;
+    if (pim.outerTolerance > 0 && momRes < pim.outerTolerance && pRes < pim.outerTolerance) {
+      res.converged = true;
+      break;
+    }
+    if (!res.ok) break;
+  }
+  storeDdtCorrection();
+  res.continuityMax = continuityMax(res.continuitySum);
+  if (!fieldsFinite() || !std::isfinite(res.continuityMax)) res.ok = false;
+  exec_.fence();
+  return res;
+}
+
+StepResult FluidSolver::solveStep(real t, real dt) {
+  beginStep(t, dt);
+  if (motion_) {
+    Real3View pts("mfsi::fluid::motionPoints", mesh_.nNodes());
+    Kokkos::deep_copy(exec_, pts, points0_);
+    exec_.fence();
+    motion_(t + dt, pts);
+    moveMesh(pts);
+  }
+  return solve();
+}
+
+}  // namespace mfsi::fluid

@@ -1,0 +1,171 @@
+#pragma once
+/// \file
+/// \brief Incompressible Navier-Stokes on a moving hex mesh: cell-centred collocated finite
+/// volumes in ALE form, PIMPLE pressure-velocity coupling with Rhie-Chow face fluxes.
+///
+/// Discretisation (integral form over a moving cell of volume V):
+///   rho d(V u)/dt + sum_f rho (phi_f - phi^m_f) u_f - mu sum_f (grad u)_f . S_f = -V grad p + rho V g,
+///   sum_f phi_f = 0,
+/// phi_f the absolute volumetric face flux and phi^m_f the mesh flux built from face swept volumes
+/// (see fluid/MeshFlux.hpp) with the time scheme's own weights, so that
+///   (c1 V^{n+1} - c0 V^n + c00 V^{n-1}) / dt = sum_f phi^m_f      (discrete space conservation)
+/// holds to round-off and a uniform flow stays uniform on any mesh motion.
+///
+/// Typical FSI use:
+/// \code
+///   FluidSolver fluid(mesh, opts);
+///   for (step...) {
+///     fluid.beginStep(t, dt);
+///     for (fsi iteration...) {
+///       fluid.moveMesh(newPoints);                    // node positions at t + dt
+///       fluid.setWallVelocity("membrane", velocity);  // per baffle face
+///       auto r = fluid.solve();                       // PIMPLE for this step, warm-started
+///       baffleNetPressure(fluid, "membrane", pNet);   // p_master - p_slave per face
+///     }
+///   }
+/// \endcode
+#include "core/MeshGeometry.hpp"
+#include "fluid/BoundaryConditions.hpp"
+#include "fluid/FluidOptions.hpp"
+#include "fluid/FvAssembly.hpp"
+#include "fluid/FvFaceData.hpp"
+#include "fluid/Gradient.hpp"
+#include "fluid/LinearSolve.hpp"
+
+#include <functional>
+#include <string>
+
+namespace mfsi::fluid {
+
+/// \brief What one call of `solve()` did.
+struct StepResult {
+  bool ok = true;          ///< false on NaN/Inf or a linear-solver breakdown
+  bool converged = false;  ///< outer loop reached `outerTolerance` (always false when it is 0)
+  int outerIterations = 0;
+  int momentumIterations = 0;   ///< linear iterations, summed
+  int pressureIterations = 0;   ///< linear iterations, summed
+  real momentumResidual = 0;    ///< initial (normalised) residual of the first momentum solve
+  real pressureResidual = 0;    ///< initial residual of the first pressure solve
+  real finalMomentumResidual = 0;  ///< initial residual of the momentum solve of the last outer iteration
+  real finalPressureResidual = 0;  ///< initial residual of the first pressure solve of the last outer iteration
+  real continuityMax = 0;  ///< max over cells of |sum_f phi_f| / V  [1/s] after the last corrector
+  real continuitySum = 0;  ///< sum over cells of |sum_f phi_f|  [m^3/s]
+};
+
+/// \brief Node positions at time t; called by `solveStep` when set with `setMeshMotion`.
+using MeshMotion = std::function<void(real time, const Real3View& points)>;
+
+/// \brief The fluid solver. Fields live on the device with labels `mfsi::fluid::*`.
+class FluidSolver {
+ public:
+  /// \brief Allocate fields, resolve boundary conditions and build the matrix sparsity.
+  /// `mesh` must outlive the solver; the solver moves its points in `moveMesh`.
+  FluidSolver(const HexMesh& mesh, const FluidOptions& options);
+
+  // --- time stepping -------------------------------------------------------------------------
+  /// \brief Start the step from t to t + dt: the current solution and geometry become the old time
+  /// levels; prescribed boundary values are evaluated at t + dt.
+  void beginStep(real t, real dt);
+  /// \brief Move the mesh to `newPoints` (positions at t + dt). May be called repeatedly within a
+  /// step (FSI iterations): swept volumes are always measured from the positions at `beginStep`.
+  void moveMesh(const ConstReal3View& newPoints);
+  /// \brief Run the PIMPLE (or, steady, SIMPLE) iterations of the current step, starting from the
+  /// current fields. May be called repeatedly within a step.
+  StepResult solve();
+  /// \brief `beginStep(t, dt)`, mesh motion from `setMeshMotion` if set, then `solve()`.
+  StepResult solveStep(real t, real dt);
+  /// \brief Mesh motion used by `solveStep`.
+  void setMeshMotion(MeshMotion motion) { motion_ = std::move(motion); }
+
+  // --- boundary input ------------------------------------------------------------------------
+  /// \brief Per-face wall velocity for a wall patch with `WallMotion::External`, or for both sides
+  /// of a baffle when `name` is the baffle name (size: faces of one side). The normal component
+  /// is replaced by the mesh's, so walls stay impermeable relative to the mesh.
+  void setWallVelocity(const std::string& name, const ConstReal3View& faceVelocity);
+
+  // --- state ---------------------------------------------------------------------------------
+  /// \brief Set the velocity field (and reset face fluxes to interpolated values).
+  void setVelocity(const ConstReal3View& u);
+  /// \brief Set the pressure field.
+  void setPressure(const ConstRealView& p);
+
+  const HexMesh& mesh() const { return mesh_; }
+  const FluidOptions& options() const { return opt_; }
+  const MeshGeometry& geometry() const { return geo_; }
+  const FvFaceData& faceData() const { return fd_; }
+  const BoundaryConditions& boundaryConditions() const { return bc_; }
+  /// Cell velocity [m/s].
+  ConstReal3View velocity() const { return U_; }
+  /// Cell pressure [Pa].
+  ConstRealView pressure() const { return p_; }
+  /// Absolute volumetric face flux u.S [m^3/s] (out of the owner), all faces.
+  ConstRealView faceFlux() const { return phi_; }
+  /// Mesh flux of the current step [m^3/s], all faces.
+  ConstRealView meshFlux() const { return meshPhi_; }
+  /// Velocity on boundary faces (index f - nInternalFaces).
+  ConstReal3View boundaryVelocity() const { return Ub_; }
+  /// Pressure on boundary faces (index f - nInternalFaces).
+  ConstRealView boundaryPressure() const { return pb_; }
+  /// Velocity gradient of the last outer iteration, G(c, i, j) = du_j/dx_i.
+  ConstTensor3View velocityGradient() const { return gradU_; }
+  /// Start time of the current step and its size.
+  real time() const { return t_; }
+  real timeStep() const { return dt_; }
+  /// Number of `beginStep` calls so far.
+  int stepIndex() const { return nSteps_; }
+
+ private:
+  void updateGeometry();
+  void computeTimeCoefficients();
+  void computeMeshFlux();
+  void updateBoundaryVelocity();
+  void updateBoundaryPressure();
+  void computeVelocityGradient();
+  void computePressureGradient();
+  void updatePressureGradient();
+  void assembleMomentum();
+  void computeHbyA();
+  void computePhiHbyA();
+  void assemblePressure();
+  void correctFluxAndVelocity();
+  void storeDdtCorrection();
+  real continuityMax(real& sum);
+  bool fieldsFinite();
+
+  const HexMesh& mesh_;
+  FluidOptions opt_;
+  ExecSpace exec_;
+  lid_t nCells_ = 0, nFaces_ = 0, nIn_ = 0, nB_ = 0;
+
+  MeshGeometry geo_;
+  FvFaceData fd_;
+  FvSparsity sparsity_;
+  CsrMatrix Au_, Ap_;
+  FaceCoefficients fcU_, fcP_;
+  BoundaryConditions bc_;
+  LinearSolver linear_;
+
+  // Cell fields.
+  Real3View U_, U0_, U00_;
+  RealView p_, pPrev_;
+  RealView V0_, V00_;
+  Real3View HbyA_, gradP_, rhsU_, bodyU_;
+  Tensor3View gradU_;
+  RealView rAU_, diagU_, cellDiag_, rhsP_, x_, b_;
+  // Face fields.
+  RealView phi_, meshPhi_, phiHbyA_, dphi_, dphi0_, dphi00_, sweptNew_, sweptOld_, fluxP_;
+  Real3View fluxU_;
+  // Boundary-face fields.
+  Real3View Ub_, faceMeshVel_;
+  RealView pb_;
+  // Mesh positions at the start of the step.
+  Real3View points0_;
+
+  real t_ = 0, dt_ = 1, dt0_ = 1;
+  int nSteps_ = 0;
+  bool bdf2Active_ = false;
+  real c1_ = 0, c0_ = 0, c00_ = 0;  ///< time weights: d(phi)/dt ~ (c1 phi - c0 phi0 + c00 phi00)/dt
+  MeshMotion motion_;
+};
+
+}  // namespace mfsi::fluid

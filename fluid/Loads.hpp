@@ -1,0 +1,38 @@
+#pragma once
+/// \file
+/// \brief Fluid loads on boundaries: traction per face, force and moment per patch, and the net
+/// pressure across a baffle (the load on a membrane).
+#include "fluid/FluidSolver.hpp"
+
+#include <string>
+
+namespace mfsi::fluid {
+
+/// \brief Integrated loads on a patch (force exerted by the fluid on the boundary).
+struct PatchLoads {
+  Vec3 pressureForce{0, 0, 0};  ///< sum_f p_f S_f
+  Vec3 viscousForce{0, 0, 0};   ///< sum_f -(tau . S)_f
+  Vec3 force{0, 0, 0};          ///< total
+  Vec3 moment{0, 0, 0};         ///< sum_f (x_f - point) x force_f
+  real area = 0;
+};
+
+/// \brief Traction (force per unit area exerted by the fluid on the boundary) on each face of
+/// patch `patch`, split in its pressure part p n and viscous part -tau.n, with n the unit normal
+/// out of the fluid and tau = mu (grad u + grad u^T). Views have the patch's size.
+///
+/// The normal derivative of u uses the boundary value and the owner cell, (u_b - u_P) / d_n; the
+/// transposed part uses the owner's cell gradient from the last outer iteration.
+void boundaryTraction(const FluidSolver& fluid, const std::string& patch, const Real3View& pressureTraction,
+                      const Real3View& viscousTraction);
+
+/// \brief Force and moment about `point` on a patch, or on both sides of a baffle when `name` is
+/// a baffle name (the two sides' pressure parts then give the net load on the membrane).
+PatchLoads patchLoads(const FluidSolver& fluid, const std::string& name, const Vec3& point = {0, 0, 0});
+
+/// \brief Net pressure across a baffle per face pair: pNet(i) = p(master face i) - p(slave face i)
+/// [Pa]. The master's outward normal is the baffle normal, so the pressure load on the membrane is
+/// pNet times the baffle normal (pointing from the master side to the slave side).
+void baffleNetPressure(const FluidSolver& fluid, const std::string& baffle, const RealView& pNet);
+
+}  // namespace mfsi::fluid

@@ -1,0 +1,107 @@
+#include "kernels/Blas.hpp"
+
+#include <cmath>
+#include <limits>
+
+namespace mfsi::blas {
+
+void spmv(const ExecSpace& exec, const CsrMatrix& A, const ConstRealView& x, const RealView& y) {
+  spmv(exec, 1.0, A, x, 0.0, y);
+}
+
+void spmv(const ExecSpace& exec, real alpha, const CsrMatrix& A, const ConstRealView& x, real beta, const RealView& y) {
+  const ConstIndexView rowPtr = A.rowPtr, colIdx = A.colIdx;
+  const ConstRealView val = A.values;
+  Kokkos::parallel_for(
+      "mfsi::kernels::blas::spmv", RangePolicy(exec, 0, A.nRows), KOKKOS_LAMBDA(lid_t i) {
+        double s = 0.0;
+        for (lid_t k = rowPtr(i); k < rowPtr(i + 1); ++k) s += val(k) * x(colIdx(k));
+        y(i) = beta == 0.0 ? alpha * s : alpha * s + beta * y(i);
+      });
+}
+
+double spmvDot(const ExecSpace& exec, const SolverComm& comm, const CsrMatrix& A, const ConstRealView& x,
+               const RealView& y, const ConstRealView& w) {
+  const ConstIndexView rowPtr = A.rowPtr, colIdx = A.colIdx;
+  const ConstRealView val = A.values;
+  return reduce<1>(
+      exec, comm, "mfsi::kernels::blas::spmvDot", A.nRows, KOKKOS_LAMBDA(lid_t i, Sums<1> & s) {
+        double ax = 0.0;
+        for (lid_t k = rowPtr(i); k < rowPtr(i + 1); ++k) ax += val(k) * x(colIdx(k));
+        y(i) = ax;
+        s[0] += w(i) * ax;
+      })[0];
+}
+
+double residual(const ExecSpace& exec, const SolverComm& comm, const CsrMatrix& A, const ConstRealView& x,
+                const ConstRealView& b, const RealView& r) {
+  const ConstIndexView rowPtr = A.rowPtr, colIdx = A.colIdx;
+  const ConstRealView val = A.values;
+  return reduce<1>(
+      exec, comm, "mfsi::kernels::blas::residual", A.nRows, KOKKOS_LAMBDA(lid_t i, Sums<1> & s) {
+        double ri = b(i);
+        for (lid_t k = rowPtr(i); k < rowPtr(i + 1); ++k) ri -= val(k) * x(colIdx(k));
+        r(i) = ri;
+        s[0] += ri * ri;
+      })[0];
+}
+
+double dot(const ExecSpace& exec, const SolverComm& comm, lid_t n, const ConstRealView& x, const ConstRealView& y) {
+  return reduce<1>(
+      exec, comm, "mfsi::kernels::blas::dot", n, KOKKOS_LAMBDA(lid_t i, Sums<1> & s) { s[0] += x(i) * y(i); })[0];
+}
+
+double norm2(const ExecSpace& exec, const SolverComm& comm, lid_t n, const ConstRealView& x) {
+  const double xx = reduce<1>(
+      exec, comm, "mfsi::kernels::blas::norm2", n, KOKKOS_LAMBDA(lid_t i, Sums<1> & s) { s[0] += x(i) * x(i); })[0];
+  return std::sqrt(xx);
+}
+
+double normInf(const ExecSpace& exec, const SolverComm& comm, lid_t n, const ConstRealView& x) {
+  // max is order-independent, so a plain Kokkos reduction is already deterministic. NaN compares
+  // false with everything and would be dropped by the max; map it to +inf so it is reported.
+  double m = 0.0;
+  const double inf = std::numeric_limits<double>::infinity();
+  Kokkos::parallel_reduce(
+      "mfsi::kernels::blas::normInf", RangePolicy(exec, 0, n),
+      KOKKOS_LAMBDA(lid_t i, double& acc) {
+        double a = kmath::fabs(x(i));
+        if (a != a) a = inf;
+        if (a > acc) acc = a;
+      },
+      Kokkos::Max<double>(m));
+  return comm.globalMax(m < 0.0 ? 0.0 : m);  // empty range: identity of Max is -inf
+}
+
+double sum(const ExecSpace& exec, const SolverComm& comm, lid_t n, const ConstRealView& x) {
+  return reduce<1>(
+      exec, comm, "mfsi::kernels::blas::sum", n, KOKKOS_LAMBDA(lid_t i, Sums<1> & s) { s[0] += x(i); })[0];
+}
+
+double mean(const ExecSpace& exec, const SolverComm& comm, lid_t n, const ConstRealView& x) {
+  const double total = comm.globalSum(static_cast<double>(n));
+  return total > 0 ? sum(exec, comm, n, x) / total : 0.0;
+}
+
+void axpy(const ExecSpace& exec, lid_t n, real alpha, const ConstRealView& x, const RealView& y) {
+  Kokkos::parallel_for(
+      "mfsi::kernels::blas::axpy", RangePolicy(exec, 0, n), KOKKOS_LAMBDA(lid_t i) { y(i) += alpha * x(i); });
+}
+
+void axpby(const ExecSpace& exec, lid_t n, real alpha, const ConstRealView& x, real beta, const RealView& y) {
+  Kokkos::parallel_for(
+      "mfsi::kernels::blas::axpby", RangePolicy(exec, 0, n),
+      KOKKOS_LAMBDA(lid_t i) { y(i) = beta == 0.0 ? alpha * x(i) : alpha * x(i) + beta * y(i); });
+}
+
+void shift(const ExecSpace& exec, lid_t n, real c, const RealView& x) {
+  Kokkos::parallel_for(
+      "mfsi::kernels::blas::shift", RangePolicy(exec, 0, n), KOKKOS_LAMBDA(lid_t i) { x(i) += c; });
+}
+
+void fill(const ExecSpace& exec, lid_t n, real value, const RealView& x) {
+  Kokkos::parallel_for(
+      "mfsi::kernels::blas::fill", RangePolicy(exec, 0, n), KOKKOS_LAMBDA(lid_t i) { x(i) = value; });
+}
+
+}  // namespace mfsi::blas

@@ -1,0 +1,774 @@
+#include "structure/MembraneSolver.hpp"
+
+#include "core/Error.hpp"
+#include "core/Timers.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+namespace mfsi {
+
+namespace {
+
+template <class T>
+Kokkos::View<const T*, HostSpace, Kokkos::MemoryTraits<Kokkos::Unmanaged>> hostView(const std::vector<T>& v) {
+  return Kokkos::View<const T*, HostSpace, Kokkos::MemoryTraits<Kokkos::Unmanaged>>(v.data(), v.size());
+}
+
+real dist(const std::array<real, 3>& a, const std::array<real, 3>& b) {
+  return std::sqrt((a[0] - b[0]) * (a[0] - b[0]) + (a[1] - b[1]) * (a[1] - b[1]) + (a[2] - b[2]) * (a[2] - b[2]));
+}
+
+}  // namespace
+
+std::vector<MembraneNodeSpring> makeAnchorSprings(const MembraneMesh& mesh, const std::vector<lid_t>& nodes,
+                                                  real stiffness) {
+  std::vector<MembraneNodeSpring> out;
+  for (lid_t n : nodes) out.push_back({n, mesh.hostPoints().at(n), stiffness, 0});
+  return out;
+}
+
+// ---------------------------------------------------------------------------------------------
+// Set-up
+// ---------------------------------------------------------------------------------------------
+
+MembraneSolver::MembraneSolver(const MembraneMesh& mesh, const MembraneOptions& options,
+                               const MembraneBoundary& boundary, const MembraneLoads& loads)
+    : mesh_(mesh), options_(options), boundary_(boundary), loads_(loads) {
+  validate(options_.material);
+  MFSI_CHECK(options_.tolerance > 0, "membrane: tolerance must be > 0");
+  MFSI_CHECK(options_.loadSteps >= 1, "membrane: loadSteps must be >= 1");
+  MFSI_CHECK(options_.lumped.limiterFraction > 0 && options_.newton.limiterFraction > 0,
+             "membrane: limiter fractions must be > 0");
+  MFSI_CHECK(options_.wrinklingStiffnessFraction >= 0, "membrane: wrinklingStiffnessFraction must be >= 0");
+  const auto& dyn = options_.dynamics;
+  MFSI_CHECK(dyn.rhoInfinity >= 0 && dyn.rhoInfinity <= 1, "membrane dynamics: rhoInfinity must be in [0, 1]");
+  MFSI_CHECK(dyn.beta > 0 && dyn.gamma >= 0.5, "membrane dynamics: need beta > 0 and gamma >= 1/2");
+  lchar_ = options_.characteristicLength > 0 ? options_.characteristicLength : std::sqrt(mesh_.referenceArea());
+
+  geometry_ = computeMembraneReferenceGeometry(exec_, mesh_);
+  data_ = makeMembraneElementData(mesh_, geometry_, options_);
+  const lid_t n3 = 3 * mesh_.nNodes();
+  u_ = RealView("mfsi::structure::membrane::u", n3);
+  v_ = RealView("mfsi::structure::membrane::v", n3);
+  a_ = RealView("mfsi::structure::membrane::a", n3);
+  R_ = RealView("mfsi::structure::membrane::residual", n3);
+  Fext_ = RealView("mfsi::structure::membrane::externalForce", n3);
+  du_ = RealView("mfsi::structure::membrane::du", n3);
+  uTrial_ = RealView("mfsi::structure::membrane::uTrial", n3);
+  work_ = RealView("mfsi::structure::membrane::work", n3);
+  work2_ = RealView("mfsi::structure::membrane::work2", n3);
+  rn_ = RealView("mfsi::structure::membrane::residualPrevious", n3);
+  pNode_ = RealView("mfsi::structure::membrane::nodePressure", mesh_.nNodes());
+  a1_ = RealView("mfsi::structure::membrane::a1", n3);
+  v1_ = RealView("mfsi::structure::membrane::v1", n3);
+  rhs_ = RealView("mfsi::structure::membrane::dynamicResidual", n3);
+  dampingForce_ = RealView("mfsi::structure::membrane::dampingForce", n3);
+  setupItems();
+  setupConstraints();
+  setupClamps();
+}
+
+void MembraneSolver::setupItems() {
+  const lid_t nN = mesh_.nNodes();
+  std::vector<std::array<lid_t, 4>> items = mesh_.hostElements();
+  auto checkNode = [&](lid_t n, const char* what) {
+    MFSI_CHECK(n >= 0 && n < nN, "membrane boundary: " << what << " node " << n << " out of range [0, " << nN << ")");
+  };
+  const auto& beams = boundary_.edgeBeams;
+  std::vector<MembraneNodeSpring> springs = boundary_.edgeSprings;
+  springs.insert(springs.end(), boundary_.cornerSprings.begin(), boundary_.cornerSprings.end());
+  const lid_t nB = static_cast<lid_t>(beams.size()), nS = static_cast<lid_t>(springs.size());
+  lines_.barNodes = Kokkos::View<lid_t* [2], MemSpace>("mfsi::structure::membrane::barNodes", nB);
+  lines_.barEA = RealView("mfsi::structure::membrane::barEA", nB);
+  lines_.barLength = RealView("mfsi::structure::membrane::barLength", nB);
+  lines_.barTensionOnly = Kokkos::View<int*, MemSpace>("mfsi::structure::membrane::barTensionOnly", nB);
+  lines_.springNode = IndexView("mfsi::structure::membrane::springNode", nS);
+  lines_.springAnchor = Real3View("mfsi::structure::membrane::springAnchor", nS);
+  lines_.springStiffness = RealView("mfsi::structure::membrane::springStiffness", nS);
+  lines_.springRestLength = RealView("mfsi::structure::membrane::springRestLength", nS);
+  auto hbn = Kokkos::create_mirror_view(lines_.barNodes);
+  auto hbe = Kokkos::create_mirror_view(lines_.barEA);
+  auto hbl = Kokkos::create_mirror_view(lines_.barLength);
+  auto hbt = Kokkos::create_mirror_view(lines_.barTensionOnly);
+  for (lid_t i = 0; i < nB; ++i) {
+    const auto& b = beams[i];
+    checkNode(b.node0, "edge beam");
+    checkNode(b.node1, "edge beam");
+    MFSI_CHECK(b.node0 != b.node1 && b.axialStiffness >= 0, "membrane edge beam " << i << ": needs two distinct nodes "
+                                                                                 << "and EA >= 0");
+    hbn(i, 0) = b.node0;
+    hbn(i, 1) = b.node1;
+    hbe(i) = b.axialStiffness;
+    hbl(i) = dist(mesh_.hostPoints()[b.node0], mesh_.hostPoints()[b.node1]);
+    hbt(i) = b.tensionOnly ? 1 : 0;
+    items.push_back({b.node0, b.node1, -1, -1});
+  }
+  auto hsn = Kokkos::create_mirror_view(lines_.springNode);
+  auto hsa = Kokkos::create_mirror_view(lines_.springAnchor);
+  auto hsk = Kokkos::create_mirror_view(lines_.springStiffness);
+  auto hsl = Kokkos::create_mirror_view(lines_.springRestLength);
+  for (lid_t i = 0; i < nS; ++i) {
+    const auto& s = springs[i];
+    checkNode(s.node, "spring");
+    MFSI_CHECK(s.stiffness >= 0, "membrane spring " << i << ": stiffness must be >= 0");
+    hsn(i) = s.node;
+    for (int k = 0; k < 3; ++k) hsa(i, k) = s.anchor[k];
+    hsk(i) = s.stiffness;
+    hsl(i) = s.restLength >= 0 ? s.restLength : dist(mesh_.hostPoints()[s.node], s.anchor);
+    items.push_back({s.node, -1, -1, -1});
+  }
+  Kokkos::deep_copy(lines_.barNodes, hbn);
+  Kokkos::deep_copy(lines_.barEA, hbe);
+  Kokkos::deep_copy(lines_.barLength, hbl);
+  Kokkos::deep_copy(lines_.barTensionOnly, hbt);
+  Kokkos::deep_copy(lines_.springNode, hsn);
+  Kokkos::deep_copy(lines_.springAnchor, hsa);
+  Kokkos::deep_copy(lines_.springStiffness, hsk);
+  Kokkos::deep_copy(lines_.springRestLength, hsl);
+
+  nItems_ = static_cast<lid_t>(items.size());
+  map_ = buildCsrAssemblyMap(items, nN, 3, "mfsi::structure::membrane::assembly");
+  K_ = makeMatrix(map_, "mfsi::structure::membrane::tangent");
+  itemVec_ = ItemValuesView("mfsi::structure::membrane::itemResidual", nItems_, kMembraneItemDofs);
+  itemExt_ = ItemValuesView("mfsi::structure::membrane::itemExternal", nItems_, kMembraneItemDofs);
+  itemMat_ = ItemValuesView("mfsi::structure::membrane::itemMatrix", nItems_, kMembraneItemMatrix);
+}
+
+void MembraneSolver::setupConstraints() {
+  const lid_t nN = mesh_.nNodes();
+  constraints_.kind = Kokkos::View<int*, MemSpace>("mfsi::structure::membrane::constraintKind", nN);
+  constraints_.direction = Real3View("mfsi::structure::membrane::constraintDirection", nN);
+  auto hk = Kokkos::create_mirror_view(constraints_.kind);
+  auto hd = Kokkos::create_mirror_view(constraints_.direction);
+  for (lid_t n = 0; n < nN; ++n) hk(n) = static_cast<int>(MembraneNodeConstraint::Free);
+  const auto& normals = mesh_.hostNodeNormals();
+  for (lid_t n : boundary_.normalNodes) {
+    MFSI_CHECK(n >= 0 && n < nN, "membrane boundary: normal-constrained node " << n << " out of range");
+    hk(n) = static_cast<int>(MembraneNodeConstraint::Direction);
+    for (int k = 0; k < 3; ++k) hd(n, k) = normals[n][k];
+  }
+  for (const auto& c : boundary_.clamps) {
+    MFSI_CHECK(c.offsets.empty() || c.offsets.size() == c.nodes.size(),
+               "membrane clamp: offsets must be empty or one per node");
+    for (lid_t n : c.nodes) {
+      MFSI_CHECK(n >= 0 && n < nN, "membrane boundary: clamped node " << n << " out of range");
+      hk(n) = static_cast<int>(MembraneNodeConstraint::Fixed);  // clamps win over normal constraints
+    }
+  }
+  Kokkos::deep_copy(constraints_.kind, hk);
+  Kokkos::deep_copy(constraints_.direction, hd);
+
+  // Sign of the pressure offset: + where the reference normal points away from insidePoint.
+  offsetSign_ = RealView("mfsi::structure::membrane::offsetSign", nN);
+  auto hs = Kokkos::create_mirror_view(offsetSign_);
+  for (lid_t n = 0; n < nN; ++n) {
+    real s = 0;
+    for (int k = 0; k < 3; ++k) s += (mesh_.hostPoints()[n][k] - loads_.insidePoint[k]) * normals[n][k];
+    hs(n) = s >= 0 ? 1.0 : -1.0;
+  }
+  Kokkos::deep_copy(offsetSign_, hs);
+}
+
+void MembraneSolver::setupClamps() {
+  for (std::size_t g = 0; g < boundary_.clamps.size(); ++g)
+    for (lid_t n : boundary_.clamps[g].nodes) clampHost_.push_back({static_cast<int>(g), n});
+  const lid_t nc = static_cast<lid_t>(clampHost_.size());
+  clampNodes_ = IndexView("mfsi::structure::membrane::clampNodes", nc);
+  clampTarget_ = Kokkos::View<real* [3], MemSpace>("mfsi::structure::membrane::clampTarget", nc);
+  clampStart_ = Kokkos::View<real* [3], MemSpace>("mfsi::structure::membrane::clampStart", nc);
+  auto h = Kokkos::create_mirror_view(clampNodes_);
+  for (lid_t i = 0; i < nc; ++i) h(i) = clampHost_[i].second;
+  Kokkos::deep_copy(clampNodes_, h);
+}
+
+// ---------------------------------------------------------------------------------------------
+// Loads, clamps, residual, tangent
+// ---------------------------------------------------------------------------------------------
+
+void MembraneSolver::clampTargets(real time) {
+  auto h = Kokkos::create_mirror_view(clampTarget_);
+  std::vector<std::size_t> index(boundary_.clamps.size(), 0);
+  std::vector<MembraneRigidTransform> frames(boundary_.clamps.size());
+  for (std::size_t g = 0; g < boundary_.clamps.size(); ++g)
+    if (boundary_.clamps[g].frame) frames[g] = boundary_.clamps[g].frame(time);
+  for (std::size_t i = 0; i < clampHost_.size(); ++i) {
+    const auto [g, n] = clampHost_[i];
+    const auto& c = boundary_.clamps[g];
+    const std::size_t j = index[g]++;
+    std::array<real, 3> X = mesh_.hostPoints()[n];
+    if (!c.offsets.empty())
+      for (int k = 0; k < 3; ++k) X[k] += c.offsets[j][k];
+    const std::array<real, 3> x = c.frame ? frames[g].apply(X) : X;
+    for (int k = 0; k < 3; ++k) h(i, k) = x[k] - mesh_.hostPoints()[n][k];
+  }
+  Kokkos::deep_copy(clampTarget_, h);
+}
+
+void MembraneSolver::applyClamps(const RealView& u, real weight) {
+  auto nodes = clampNodes_;
+  auto target = clampTarget_;
+  auto start = clampStart_;
+  Kokkos::parallel_for(
+      "mfsi::structure::membrane::applyClamps", RangePolicy(exec_, 0, static_cast<lid_t>(nodes.extent(0))),
+      KOKKOS_LAMBDA(lid_t i) {
+        for (int k = 0; k < 3; ++k)
+          u(3 * nodes(i) + k) = start(i, k) + weight * (target(i, k) - start(i, k));
+      });
+}
+
+void MembraneSolver::updatePressure(real time, real loadFactor) {
+  const real uniform = loadFactor * loads_.pressure * (loads_.pressureTime ? loads_.pressureTime(time) : 1.0);
+  const real ramp = loads_.pressureOffsetRampTime > 0 ? std::min<real>(1, time / loads_.pressureOffsetRampTime) : 1;
+  const real offset = loadFactor * loads_.pressureOffset * ramp;
+  const bool hasField = loads_.nodePressure.extent(0) > 0;
+  MFSI_CHECK(!hasField || static_cast<lid_t>(loads_.nodePressure.extent(0)) == mesh_.nNodes(),
+             "membrane loads: nodePressure must have one value per node");
+  MFSI_CHECK(loads_.elementPressure.extent(0) == 0 ||
+                 static_cast<lid_t>(loads_.elementPressure.extent(0)) == mesh_.nElements(),
+             "membrane loads: elementPressure must have one value per element");
+  auto p = pNode_;
+  auto field = loads_.nodePressure;
+  auto sign = offsetSign_;
+  Kokkos::parallel_for(
+      "mfsi::structure::membrane::nodePressure", RangePolicy(exec_, 0, mesh_.nNodes()), KOKKOS_LAMBDA(lid_t n) {
+        p(n) = uniform + (hasField ? loadFactor * field(n) : 0) + sign(n) * offset;
+      });
+  if (loads_.elementPressure.extent(0) == 0) {
+    pElem_ = RealView();
+  } else if (loadFactor == 1) {
+    pElem_ = loads_.elementPressure;
+  } else {
+    if (pElemScaled_.extent(0) != loads_.elementPressure.extent(0))
+      pElemScaled_ = RealView("mfsi::structure::membrane::elementPressureScaled", loads_.elementPressure.extent(0));
+    blas::axpby(exec_, mesh_.nElements(), loadFactor, loads_.elementPressure, 0.0, pElemScaled_);
+    pElem_ = pElemScaled_;
+  }
+}
+
+MembranePressureKernel MembraneSolver::pressureKernel(bool withStiffness) const {
+  MembranePressureKernel pr;
+  pr.nodePressure = pNode_;
+  pr.elementPressure = pElem_;
+  pr.follower = loads_.direction == MembranePressureDirection::Follower;
+  pr.lumped = loads_.integration == MembranePressureIntegration::Lumped;
+  pr.stiffness = withStiffness && options_.newton.pressureStiffness == MembranePressureStiffness::Symmetrized;
+  return pr;
+}
+
+void MembraneSolver::evalResidual(const ConstRealView& u, real time, real loadFactor) {
+  updatePressure(time, loadFactor);
+  membraneResidualItems(exec_, data_, pressureKernel(false), lines_, u, itemVec_, itemExt_);
+  gatherItemVectors(exec_, map_, itemVec_, R_);
+  gatherItemVectors(exec_, map_, itemExt_, Fext_);
+  if (loads_.nodeForce.extent(0) > 0) {
+    MFSI_CHECK(static_cast<lid_t>(loads_.nodeForce.extent(0)) == mesh_.nNodes(),
+               "membrane loads: nodeForce must have one row per node");
+    auto f = loads_.nodeForce;
+    auto R = R_;
+    auto F = Fext_;
+    Kokkos::parallel_for(
+        "mfsi::structure::membrane::nodeForce", RangePolicy(exec_, 0, mesh_.nNodes()), KOKKOS_LAMBDA(lid_t n) {
+          for (int k = 0; k < 3; ++k) {
+            R(3 * n + k) += loadFactor * f(n, k);
+            F(3 * n + k) += loadFactor * f(n, k);
+          }
+        });
+  }
+}
+
+void MembraneSolver::assembleTangentAt(const ConstRealView& u, bool withPressure) {
+  membraneTangentItems(exec_, data_, pressureKernel(withPressure), lines_, u, itemMat_);
+  gatherItemMatrices(exec_, map_, itemMat_, K_);
+}
+
+RealView MembraneSolver::residual(real time, real loadFactor) {
+  evalResidual(u_, time, loadFactor);
+  return R_;
+}
+
+const CsrMatrix& MembraneSolver::assembleTangent(real time, bool withPressureStiffness) {
+  updatePressure(time, 1);
+  assembleTangentAt(u_, withPressureStiffness);
+  return K_;
+}
+
+const CsrMatrix& MembraneSolver::assembleConsistentMass() {
+  if (M_.values.extent(0) == 0) M_ = makeMatrix(map_, "mfsi::structure::membrane::mass");
+  membraneMassItems(exec_, data_, nItems_, false, itemMat_);
+  gatherItemMatrices(exec_, map_, itemMat_, M_);
+  return M_;
+}
+
+MembraneSolver::Norms MembraneSolver::norms(const ConstRealView& r) {
+  auto kind = constraints_.kind;
+  auto dir = constraints_.direction;
+  auto F = Fext_;
+  const auto s = blas::reduce<3>(exec_, SolverComm{}, "mfsi::structure::membrane::norms", mesh_.nNodes(),
+                                 KOKKOS_LAMBDA(lid_t n, blas::Sums<3> & acc) {
+                                   real v[3] = {r(3 * n), r(3 * n + 1), r(3 * n + 2)};
+                                   const real full = v[0] * v[0] + v[1] * v[1] + v[2] * v[2];
+                                   membrane::projectNode(kind(n), dir(n, 0), dir(n, 1), dir(n, 2), v);
+                                   const real fr = v[0] * v[0] + v[1] * v[1] + v[2] * v[2];
+                                   acc[0] += fr;
+                                   acc[1] += full - fr;
+                                   for (int k = 0; k < 3; ++k) acc[2] += F(3 * n + k) * F(3 * n + k);
+                                 });
+  Norms out;
+  out.free = std::sqrt(s[0]);
+  out.reaction = std::sqrt(std::max<real>(0, s[1]));
+  out.external = std::sqrt(s[2]);
+  return out;
+}
+
+real MembraneSolver::relativeResidual(const Norms& q, real initialFree) {
+  // The reference force: loads, support reactions, and the out-of-balance force the solve started
+  // from. The last one matters when the answer carries no force at all (a slack membrane, a rigid
+  // motion): loads and reactions then both tend to zero and their ratio to the residual need not.
+  const real scale = std::max({q.external, q.reaction, initialFree});
+  return scale > 0 ? q.free / scale : 0.0;
+}
+
+real MembraneSolver::maxNodalNorm(const ConstRealView& d) {
+  real m = 0;
+  Kokkos::parallel_reduce(
+      "mfsi::structure::membrane::maxNodalNorm", RangePolicy(exec_, 0, mesh_.nNodes()),
+      KOKKOS_LAMBDA(lid_t n, real & acc) {
+        const real s = kmath::sqrt(d(3 * n) * d(3 * n) + d(3 * n + 1) * d(3 * n + 1) + d(3 * n + 2) * d(3 * n + 2));
+        if (!(s <= acc)) acc = s;  // NaN propagates
+      },
+      Kokkos::Max<real>(m));
+  return m;
+}
+
+// ---------------------------------------------------------------------------------------------
+// Statics
+// ---------------------------------------------------------------------------------------------
+
+MembraneSolveReport MembraneSolver::solveStatic(real time) {
+  ScopedRegion region("mfsi::structure::membrane::static");
+  const double t0 = wallSeconds();
+  time_ = time;
+  clampTargets(time);
+  // Ramp the clamps from where they are now.
+  {
+    auto nodes = clampNodes_;
+    auto start = clampStart_;
+    auto u = u_;
+    Kokkos::parallel_for(
+        "mfsi::structure::membrane::clampStart", RangePolicy(exec_, 0, static_cast<lid_t>(nodes.extent(0))),
+        KOKKOS_LAMBDA(lid_t i) {
+          for (int k = 0; k < 3; ++k) start(i, k) = u(3 * nodes(i) + k);
+        });
+  }
+  MembraneSolveReport total;
+  total.converged = true;
+  for (int s = 1; s <= options_.loadSteps; ++s) {
+    const real lambda = static_cast<real>(s) / options_.loadSteps;
+    applyClamps(u_, lambda);
+    const MembraneSolveReport r = options_.solver == MembraneStaticSolver::Newton ? newtonSolve(time, lambda)
+                                                                                  : lumpedSolve(time, lambda);
+    total.iterations += r.iterations;
+    total.linearIterations += r.linearIterations;
+    total.lineSearchSteps += r.lineSearchSteps;
+    total.relativeResidual = r.relativeResidual;
+    if (!r.converged) {
+      total.converged = false;
+      break;
+    }
+  }
+  exec_.fence();
+  total.seconds = wallSeconds() - t0;
+  last_ = total;
+  return total;
+}
+
+MembraneSolveReport MembraneSolver::newtonSolve(real time, real loadFactor) {
+  const auto& opt = options_.newton;
+  const lid_t n3 = 3 * mesh_.nNodes();
+  MembraneSolveReport rep;
+  evalResidual(u_, time, loadFactor);
+  Norms nrm = norms(R_);
+  const real initialFree = nrm.free;
+  auto relative = [&](const Norms& q) { return relativeResidual(q, initialFree); };
+  real rel = relative(nrm);
+  const real dmax = opt.limiterFraction * lchar_;
+  for (int it = 0; it < opt.maxIterations; ++it) {
+    rep.relativeResidual = rel;
+    if (rel <= options_.tolerance) {
+      rep.converged = true;
+      return rep;
+    }
+    if (!std::isfinite(rel)) return rep;
+    // Inexact Newton forcing (see MembraneNewtonOptions::cgRelTol).
+    const real eta = opt.cgRelTol > 0 ? opt.cgRelTol
+                                      : std::min<real>(1e-2, std::max<real>(std::min<real>(rel, 1e-2),
+                                                                            0.5 * options_.tolerance / rel));
+    assembleTangentAt(u_, true);
+    MembraneCgResult cg = cg_.solve(exec_, K_, constraints_, R_, du_, eta, opt.cgMaxIterations);
+    rep.linearIterations += cg.iterations;
+    if (cg.negativeCurvature) {
+      // The load stiffness made the matrix indefinite (far from equilibrium): drop it this step.
+      assembleTangentAt(u_, false);
+      cg = cg_.solve(exec_, K_, constraints_, R_, du_, eta, opt.cgMaxIterations);
+      rep.linearIterations += cg.iterations;
+    }
+    ++rep.iterations;
+    // Limiter: scale the whole step (direction kept) so no node moves more than dmax.
+    const real dn = maxNodalNorm(du_);
+    if (!std::isfinite(dn) || dn == 0) return rep;
+    const real alphaMax = dn > dmax ? dmax / dn : 1.0;
+    // Line search on the directional derivative g(alpha) = du . R(u + alpha du) (Crisfield;
+    // Matthies & Strang): for a conservative problem g is minus the slope of the potential energy
+    // along du, and we look for its root. Unlike a residual-norm backtracking, it also
+    // *extrapolates*, which is what a membrane needs: from a flat or slack state the tangent is
+    // far too soft (stress ~ deflection^2), the Newton step overshoots by orders of magnitude and
+    // the root of g gives the right amplitude in a few residual evaluations. Near the solution
+    // g(1) ~ 0 and the full step is taken at the cost of one residual.
+    const real g0 = blas::dot(exec_, SolverComm{}, n3, du_, R_);
+    real alpha = alphaMax, lo = 0, gLo = g0, hi = -1, gHi = 0;
+    real bestAlpha = alpha, bestG = -1;
+    int evals = 0;
+    for (;;) {
+      Kokkos::deep_copy(exec_, uTrial_, u_);
+      blas::axpy(exec_, n3, alpha, du_, uTrial_);
+      evalResidual(uTrial_, time, loadFactor);
+      ++evals;
+      const real g = blas::dot(exec_, SolverComm{}, n3, du_, R_);
+      if (std::isfinite(g) && (bestG < 0 || std::abs(g) < bestG)) {
+        bestG = std::abs(g);
+        bestAlpha = alpha;
+      }
+      // Accept: |g| reduced enough, or no descent information (g0 <= 0: indefinite direction).
+      if (!(g0 > 0) || (std::isfinite(g) && std::abs(g) <= 0.5 * g0)) break;
+      if (evals > opt.maxLineSearchSteps) {
+        if (alpha != bestAlpha) {
+          alpha = bestAlpha;
+          Kokkos::deep_copy(exec_, uTrial_, u_);
+          blas::axpy(exec_, n3, alpha, du_, uTrial_);
+          evalResidual(uTrial_, time, loadFactor);
+        }
+        break;
+      }
+      ++rep.lineSearchSteps;
+      if (std::isfinite(g) && g > 0) {
+        // Root beyond alpha.
+        if (alpha >= alphaMax) break;  // the limiter forbids going further: take the step
+        lo = alpha;
+        gLo = g;
+        if (hi > 0) {
+          alpha = lo + (hi - lo) * gLo / (gLo - gHi);
+        } else {
+          const real secant = g < g0 ? alpha * g0 / (g0 - g) : 4 * alpha;  // root of the line through (0,g0), (alpha,g)
+          alpha = std::min(alphaMax, std::min(secant, 4 * alpha));
+        }
+      } else {
+        // Overshoot (or non-finite): bracket and interpolate (regula falsi, kept off the ends).
+        hi = alpha;
+        gHi = std::isfinite(g) ? g : -10 * g0;
+        const real t = gLo / (gLo - gHi);
+        alpha = lo + (hi - lo) * std::min<real>(0.9, std::max<real>(0.1, t));
+      }
+    }
+    nrm = norms(R_);
+    Kokkos::deep_copy(exec_, u_, uTrial_);
+    rel = relative(nrm);
+  }
+  rep.relativeResidual = rel;
+  rep.converged = rel <= options_.tolerance;
+  return rep;
+}
+
+MembraneSolveReport MembraneSolver::lumpedSolve(real time, real loadFactor) {
+  const auto& opt = options_.lumped;
+  MembraneSolveReport rep;
+  evalResidual(u_, time, loadFactor);
+  Norms nrm = norms(R_);
+  const real initialFree = nrm.free;
+  auto relative = [&](const Norms& q) { return relativeResidual(q, initialFree); };
+  real rel = relative(nrm);
+  const real dmax = opt.limiterFraction * lchar_;
+  // Bidirectional limiter: every nodal step is clipped to |du| <= cap in any direction, and the
+  // cap itself goes both ways: halved when the residual grew, grown back (x 1.2, up to dmax) while
+  // it shrinks.
+  real cap = dmax;
+  const real floorFrac = opt.stiffnessFloor;
+  auto kind = constraints_.kind;
+  auto dir = constraints_.direction;
+  for (int it = 0; it < opt.maxIterations; ++it) {
+    rep.relativeResidual = rel;
+    if (rel <= options_.tolerance) {
+      rep.converged = true;
+      return rep;
+    }
+    if (!std::isfinite(rel)) return rep;
+    membraneLumpedStiffnessItems(exec_, data_, lines_, u_, itemVec_);
+    gatherItemVectors(exec_, map_, itemVec_, work_);
+    auto D = work_;
+    auto R = R_;
+    auto u = u_;
+    const real c = cap;
+    Kokkos::parallel_for(
+        "mfsi::structure::membrane::lumpedUpdate", RangePolicy(exec_, 0, mesh_.nNodes()), KOKKOS_LAMBDA(lid_t n) {
+          const real dm = kmath::fabs(D(3 * n)) > kmath::fabs(D(3 * n + 1))
+                              ? (kmath::fabs(D(3 * n)) > kmath::fabs(D(3 * n + 2)) ? D(3 * n) : D(3 * n + 2))
+                              : (kmath::fabs(D(3 * n + 1)) > kmath::fabs(D(3 * n + 2)) ? D(3 * n + 1) : D(3 * n + 2));
+          const real lo = floorFrac * kmath::fabs(dm);
+          real d[3];
+          for (int k = 0; k < 3; ++k) {
+            const real kk = D(3 * n + k) > lo ? D(3 * n + k) : lo;
+            d[k] = kk > 0 ? R(3 * n + k) / kk : 0;
+          }
+          membrane::projectNode(kind(n), dir(n, 0), dir(n, 1), dir(n, 2), d);
+          const real l = kmath::sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]);
+          const real s = l > c ? c / l : 1.0;
+          for (int k = 0; k < 3; ++k) u(3 * n + k) += s * d[k];
+        });
+    ++rep.iterations;
+    evalResidual(u_, time, loadFactor);
+    const Norms next = norms(R_);
+    cap = next.free > nrm.free ? std::max<real>(0.5 * cap, 1e-6 * dmax) : std::min<real>(dmax, 1.2 * cap);
+    nrm = next;
+    rel = relative(nrm);
+  }
+  rep.relativeResidual = rel;
+  rep.converged = rel <= options_.tolerance;
+  return rep;
+}
+
+// ---------------------------------------------------------------------------------------------
+// Dynamics
+// ---------------------------------------------------------------------------------------------
+
+MembraneSolveReport MembraneSolver::step(real dt) {
+  ScopedRegion region("mfsi::structure::membrane::step");
+  MFSI_CHECK(dt > 0, "membrane step: dt must be > 0");
+  MFSI_CHECK(options_.material.density > 0, "membrane dynamics needs density > 0");
+  const double wall0 = wallSeconds();
+  const auto& dyn = options_.dynamics;
+  const lid_t n3 = 3 * mesh_.nNodes();
+  const bool lumpedMass = dyn.mass == MembraneMassType::Lumped;
+  real am = 0, af = 0, beta = dyn.beta, gamma = dyn.gamma;
+  if (dyn.integrator == MembraneTimeIntegrator::GeneralizedAlpha) {
+    const real rho = dyn.rhoInfinity;
+    am = (2 * rho - 1) / (rho + 1);
+    af = rho / (rho + 1);
+    gamma = 0.5 - am + af;
+    beta = 0.25 * (1 - am + af) * (1 - am + af);
+  }
+  if (!haveMass_) {
+    if (lumpedMass) {
+      lumpedMass_ = RealView("mfsi::structure::membrane::lumpedMass", n3);
+      membraneMassItems(exec_, data_, nItems_, true, itemVec_);
+      gatherItemVectors(exec_, map_, itemVec_, lumpedMass_);
+    } else {
+      assembleConsistentMass();
+    }
+    Kdamp_ = makeMatrix(map_, "mfsi::structure::membrane::dampingStiffness");
+    haveMass_ = true;
+  }
+  const real ra = dyn.rayleighAlpha, rb = dyn.rayleighBeta;
+  auto mass = [&](const ConstRealView& x, const RealView& y) {
+    if (lumpedMass) {
+      auto m = lumpedMass_;
+      Kokkos::parallel_for(
+          "mfsi::structure::membrane::lumpedMassApply", RangePolicy(exec_, 0, n3),
+          KOKKOS_LAMBDA(lid_t i) { y(i) = m(i) * x(i); });
+    } else {
+      blas::spmv(exec_, M_, x, y);
+    }
+  };
+  // y = C x = ra M x + rb Kdamp x (y must not alias x).
+  auto damping = [&](const ConstRealView& x, const RealView& y) {
+    blas::fill(exec_, n3, 0.0, y);
+    if (ra != 0) {
+      mass(x, work2_);
+      blas::axpy(exec_, n3, ra, work2_, y);
+    }
+    if (rb != 0) blas::spmv(exec_, rb, Kdamp_, x, 1.0, y);
+  };
+
+  // Damping stiffness: the tangent at the start of the step (frozen during the step).
+  if (rb != 0) {
+    updatePressure(time_, 1);
+    assembleTangentAt(u_, false);
+    Kokkos::deep_copy(exec_, Kdamp_.values, K_.values);
+  }
+  // Residual at t_n (needed by generalized-alpha) and, the first time, a_n from M a = R - C v.
+  evalResidual(u_, time_, 1);
+  Kokkos::deep_copy(exec_, rn_, R_);
+  MembraneSolveReport rep;
+  if (!haveAcceleration_) {
+    damping(v_, work_);
+    blas::axpby(exec_, n3, 1.0, R_, -1.0, work_);  // work = R - C v
+    if (lumpedMass) {
+      auto m = lumpedMass_;
+      auto w = work_;
+      auto a = a_;
+      Kokkos::parallel_for(
+          "mfsi::structure::membrane::initialAcceleration", RangePolicy(exec_, 0, n3),
+          KOKKOS_LAMBDA(lid_t i) { a(i) = m(i) > 0 ? w(i) / m(i) : 0; });
+      projectConstraints(exec_, constraints_, a_, a_);
+    } else {
+      const auto r = cg_.solve(exec_, M_, constraints_, work_, a_, 1e-12, 10000);
+      rep.linearIterations += r.iterations;
+    }
+    haveAcceleration_ = true;
+  }
+
+  const real t1 = time_ + dt;
+  // Predictor with a_{n+1} = 0, then the clamps at t_{n+1}.
+  Kokkos::deep_copy(exec_, uTrial_, u_);
+  blas::axpy(exec_, n3, dt, v_, uTrial_);
+  blas::axpy(exec_, n3, (0.5 - beta) * dt * dt, a_, uTrial_);
+  clampTargets(t1);
+  Kokkos::deep_copy(exec_, clampStart_, clampTarget_);
+  applyClamps(uTrial_, 1);
+
+  const RealView a1 = a1_, v1 = v1_, rhs = rhs_;
+  const real cM = (1 - am) / (beta * dt * dt), cC = (1 - af) * gamma / (beta * dt);
+  auto kinematics = [&]() {
+    // a1 = (u1 - un - dt vn)/(beta dt^2) - (1/(2 beta) - 1) an ;  v1 = vn + dt((1-gamma) an + gamma a1)
+    auto u1 = uTrial_;
+    auto un = u_;
+    auto vn = v_;
+    auto an = a_;
+    auto A1 = a1;
+    auto V1 = v1;
+    Kokkos::parallel_for(
+        "mfsi::structure::membrane::newmarkKinematics", RangePolicy(exec_, 0, n3), KOKKOS_LAMBDA(lid_t i) {
+          const real acc = (u1(i) - un(i) - dt * vn(i)) / (beta * dt * dt) - (0.5 / beta - 1) * an(i);
+          A1(i) = acc;
+          V1(i) = vn(i) + dt * ((1 - gamma) * an(i) + gamma * acc);
+        });
+  };
+  const auto& nopt = options_.newton;
+  real rel = 1;
+  for (int it = 0; it < nopt.maxIterations; ++it) {
+    kinematics();
+    evalResidual(uTrial_, t1, 1);
+    // rhs = (1-af) R1 + af Rn - M((1-am) a1 + am an) - C((1-af) v1 + af vn)
+    Kokkos::deep_copy(exec_, work_, a1);
+    blas::axpby(exec_, n3, am, a_, 1 - am, work_);
+    mass(work_, rhs);  // rhs = M a_mid (inertia)
+    const real inertia = blas::norm2(exec_, SolverComm{}, n3, rhs);
+    blas::axpby(exec_, n3, 1 - af, R_, -1.0, rhs);
+    blas::axpy(exec_, n3, af, rn_, rhs);
+    if (ra != 0 || rb != 0) {
+      Kokkos::deep_copy(exec_, work_, v1);
+      blas::axpby(exec_, n3, af, v_, 1 - af, work_);
+      damping(work_, dampingForce_);
+      blas::axpy(exec_, n3, -1.0, dampingForce_, rhs);
+    }
+    const Norms nrm = norms(rhs);
+    const real scale = std::max({nrm.external, nrm.reaction, inertia});
+    rel = scale > 0 ? nrm.free / scale : (nrm.free > 0 ? 1.0 : 0.0);
+    rep.relativeResidual = rel;
+    if (rel <= options_.tolerance) {
+      rep.converged = true;
+      break;
+    }
+    if (!std::isfinite(rel)) break;
+    // Effective matrix (1-af) K + cM M + cC C on the shared sparsity.
+    assembleTangentAt(uTrial_, true);
+    {
+      auto K = K_.values;
+      auto M = M_.values;
+      auto Kd = Kdamp_.values;
+      const bool consistent = !lumpedMass;
+      const bool useKd = rb != 0;
+      Kokkos::parallel_for(
+          "mfsi::structure::membrane::effectiveMatrix", RangePolicy(exec_, 0, K_.nnz()), KOKKOS_LAMBDA(lid_t p) {
+            real v = (1 - af) * K(p);
+            if (consistent) v += (cM + cC * ra) * M(p);
+            if (useKd) v += cC * rb * Kd(p);
+            K(p) = v;
+          });
+      if (lumpedMass) {
+        auto diag = K_.diagIdx;
+        auto m = lumpedMass_;
+        Kokkos::parallel_for(
+            "mfsi::structure::membrane::effectiveLumped", RangePolicy(exec_, 0, n3),
+            KOKKOS_LAMBDA(lid_t i) { K(diag(i)) += (cM + cC * ra) * m(i); });
+      }
+    }
+    const real eta = std::min<real>(1e-2, std::max<real>(std::min<real>(rel, 1e-2), 0.5 * options_.tolerance / rel));
+    const MembraneCgResult cg = cg_.solve(exec_, K_, constraints_, rhs, du_, eta, nopt.cgMaxIterations);
+    rep.linearIterations += cg.iterations;
+    blas::axpy(exec_, n3, 1.0, du_, uTrial_);
+    ++rep.iterations;
+  }
+  if (rep.converged) {
+    Kokkos::deep_copy(exec_, u_, uTrial_);
+    Kokkos::deep_copy(exec_, v_, v1);
+    Kokkos::deep_copy(exec_, a_, a1);
+    time_ = t1;
+  }
+  exec_.fence();
+  rep.seconds = wallSeconds() - wall0;
+  last_ = rep;
+  return rep;
+}
+
+// ---------------------------------------------------------------------------------------------
+// Output
+// ---------------------------------------------------------------------------------------------
+
+MembraneResults MembraneSolver::results() {
+  MembraneResults r;
+  const lid_t nN = mesh_.nNodes();
+  r.displacement = Real3View("mfsi::structure::membrane::out::displacement", nN);
+  r.displacementMagnitude = RealView("mfsi::structure::membrane::out::displacementMagnitude", nN);
+  auto d = r.displacement;
+  auto m = r.displacementMagnitude;
+  auto u = u_;
+  Kokkos::parallel_for(
+      "mfsi::structure::membrane::out::nodes", RangePolicy(exec_, 0, nN), KOKKOS_LAMBDA(lid_t n) {
+        for (int k = 0; k < 3; ++k) d(n, k) = u(3 * n + k);
+        m(n) = kmath::sqrt(u(3 * n) * u(3 * n) + u(3 * n + 1) * u(3 * n + 1) + u(3 * n + 2) * u(3 * n + 2));
+      });
+  r.elements = allocateMembraneElementOutput(mesh_.nElements());
+  membraneElementOutput(exec_, data_, u_, r.elements);
+  exec_.fence();
+  return r;
+}
+
+std::map<std::string, double> MembraneSolver::summary() {
+  const MembraneResults r = results();
+  auto um = Kokkos::create_mirror_view_and_copy(HostSpace(), r.displacementMagnitude);
+  auto uh = Kokkos::create_mirror_view_and_copy(HostSpace(), r.displacement);
+  auto s1 = Kokkos::create_mirror_view_and_copy(HostSpace(), r.elements.principal1);
+  auto s2 = Kokkos::create_mirror_view_and_copy(HostSpace(), r.elements.principal2);
+  auto vm = Kokkos::create_mirror_view_and_copy(HostSpace(), r.elements.vonMises);
+  auto ws = Kokkos::create_mirror_view_and_copy(HostSpace(), r.elements.wrinkleState);
+  std::map<std::string, double> out;
+  double maxU = 0;
+  for (lid_t n = 0; n < mesh_.nNodes(); ++n) maxU = std::max<double>(maxU, um(n));
+  const lid_t c = mesh_.hasNodeSet("centre") && !mesh_.nodeSet("centre").empty() ? mesh_.nodeSet("centre").front()
+                                                                                 : mesh_.centreNode();
+  double wc = 0;
+  for (int k = 0; k < 3; ++k) wc += uh(c, k) * mesh_.hostNodeNormals()[c][k];
+  double maxVm = 0, maxS1 = -1e300, minS2 = 1e300, wr = 0, sl = 0;
+  const auto& area = mesh_.elementAreas();
+  for (lid_t e = 0; e < mesh_.nElements(); ++e) {
+    maxVm = std::max<double>(maxVm, vm(e));
+    maxS1 = std::max<double>(maxS1, s1(e));
+    minS2 = std::min<double>(minS2, s2(e));
+    if (ws(e) == static_cast<int>(MembraneWrinkleState::Wrinkled)) wr += area[e];
+    if (ws(e) == static_cast<int>(MembraneWrinkleState::Slack)) sl += area[e];
+  }
+  out["maxDisplacement"] = maxU;
+  out["centreDeflection"] = wc;
+  out["maxVonMises"] = maxVm;
+  out["maxPrincipalStress"] = maxS1;
+  out["minPrincipalStress"] = minS2;
+  out["wrinkledFraction"] = wr / mesh_.referenceArea();
+  out["slackFraction"] = sl / mesh_.referenceArea();
+  out["iterations"] = last_.iterations;
+  out["linearIterations"] = last_.linearIterations;
+  out["relativeResidual"] = last_.relativeResidual;
+  out["time"] = time_;
+  return out;
+}
+
+}  // namespace mfsi

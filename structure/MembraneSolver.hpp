@@ -1,0 +1,153 @@
+#pragma once
+/// \file
+/// \brief Geometrically nonlinear Total-Lagrangian membrane solver: statics by lumped
+/// Newton-Raphson (diagonal stiffness + displacement limiter) or consistent-tangent Newton
+/// (CSR + Jacobi-CG + backtracking line search), and implicit dynamics (Newmark or
+/// generalized-alpha, consistent or lumped mass, Rayleigh damping).
+///
+/// Example (Hencky's problem):
+/// \code
+///   MembraneDiscSpec disc;  disc.radius = 1;  disc.nCore = disc.nRing = 8;
+///   MembraneMesh mesh = buildMembraneMesh(generateDiscMesh(disc));
+///   MembraneOptions opt;    opt.material = {1e9, 0.3, 1e-3, 1000, 0};  // E, nu, h, rho, T0
+///   MembraneBoundary bc;    bc.clamps.push_back({mesh.nodeSet("boundary"), {}, {}});
+///   MembraneLoads loads;    loads.pressure = 100;
+///   MembraneSolver solver(mesh, opt, bc, loads);
+///   MembraneSolveReport rep = solver.solveStatic();
+///   double w0 = solver.summary().at("centreDeflection");
+/// \endcode
+///
+/// State vectors are flat device Views with 3 entries per node (x, y, z).
+#include "structure/MembraneElements.hpp"
+#include "structure/MembraneLinearSolve.hpp"
+
+#include <map>
+#include <string>
+
+namespace mfsi {
+
+/// \brief Outcome of a static solve or a time step.
+struct MembraneSolveReport {
+  bool converged = false;
+  int iterations = 0;        ///< nonlinear iterations (summed over load steps)
+  int linearIterations = 0;  ///< CG iterations (Newton)
+  int lineSearchSteps = 0;   ///< residual evaluations beyond the first per Newton step
+  real relativeResidual = 0;
+  double seconds = 0;
+};
+
+/// \brief Nodal and element results (device Views).
+struct MembraneResults {
+  Real3View displacement;
+  RealView displacementMagnitude;
+  MembraneElementOutput elements;  ///< element-centre strain, PK2 stress, principal, von Mises, wrinkle state
+};
+
+/// \brief Springs from nodes to anchors at their reference positions (zero rest length: the
+/// isotropic spring -k u).
+std::vector<MembraneNodeSpring> makeAnchorSprings(const MembraneMesh& mesh, const std::vector<lid_t>& nodes,
+                                                  real stiffness);
+
+/// \brief One membrane: mesh, options, boundary, loads and state.
+class MembraneSolver {
+ public:
+  /// Throws InputError for invalid material, options or node ids in the boundary description.
+  MembraneSolver(const MembraneMesh& mesh, const MembraneOptions& options, const MembraneBoundary& boundary = {},
+                 const MembraneLoads& loads = {});
+
+  const MembraneMesh& mesh() const { return mesh_; }
+  const MembraneOptions& options() const { return options_; }
+  /// Loads are mutable between solves (e.g. the coupling refills `nodePressure`).
+  MembraneLoads& loads() { return loads_; }
+
+  /// \brief Static equilibrium at time `time` (time functions, ramps and clamp frames are
+  /// evaluated there), starting from the current displacement, with `options().loadSteps`
+  /// increments. Sets the current time. Never throws on non-convergence: see the report.
+  MembraneSolveReport solveStatic(real time = 0);
+
+  /// \brief One implicit time step of size dt from the current state (Newton with the
+  /// consistent tangent, whatever `options().solver`: the mass term keeps the matrix definite).
+  MembraneSolveReport step(real dt);
+
+  real time() const { return time_; }
+  void setTime(real t) { time_ = t; }
+  /// Displacement (writable: initial conditions); call `resetDynamics()` after editing u or v.
+  RealView displacement() const { return u_; }
+  RealView velocity() const { return v_; }
+  RealView acceleration() const { return a_; }
+  /// Forget the stored acceleration; the next `step` recomputes it from M a = R - C v.
+  void resetDynamics() { haveAcceleration_ = false; }
+
+  /// \brief Results at the current state.
+  MembraneResults results();
+  /// \brief Scalar metrics: maxDisplacement, centreDeflection (along the reference normal of the
+  /// "centre" node), maxVonMises, maxPrincipalStress, minPrincipalStress, wrinkledFraction and
+  /// slackFraction (of the reference area), iterations and relativeResidual of the last solve, time.
+  std::map<std::string, double> summary();
+  const MembraneSolveReport& lastReport() const { return last_; }
+
+  // Building blocks, public for tests, benchmarks and coupling.
+
+  /// \brief R = f_ext - f_int (unprojected; at fixed nodes -R is the support reaction) at the
+  /// current displacement, loads at `time` scaled by loadFactor.
+  RealView residual(real time, real loadFactor = 1);
+  /// \brief Newton matrix at the current displacement and loads at `time` (CSR, all rows).
+  const CsrMatrix& assembleTangent(real time, bool withPressureStiffness = true);
+  /// \brief Consistent mass matrix (CSR, same sparsity as the tangent).
+  const CsrMatrix& assembleConsistentMass();
+  const CsrAssemblyMap& assemblyMap() const { return map_; }
+  const MembraneConstraints& constraints() const { return constraints_; }
+  real characteristicLength() const { return lchar_; }
+
+ private:
+  struct Norms {
+    real free = 0, reaction = 0, external = 0;
+  };
+
+  void setupItems();
+  void setupConstraints();
+  void setupClamps();
+  void updatePressure(real time, real loadFactor);
+  MembranePressureKernel pressureKernel(bool withStiffness) const;
+  void evalResidual(const ConstRealView& u, real time, real loadFactor);
+  void assembleTangentAt(const ConstRealView& u, bool withPressure);
+  void clampTargets(real time);
+  void applyClamps(const RealView& u, real weight);
+  Norms norms(const ConstRealView& r);
+  static real relativeResidual(const Norms& q, real initialFree);
+  real maxNodalNorm(const ConstRealView& d);
+
+  MembraneSolveReport newtonSolve(real time, real loadFactor);
+  MembraneSolveReport lumpedSolve(real time, real loadFactor);
+
+  MembraneMesh mesh_;
+  MembraneOptions options_;
+  MembraneBoundary boundary_;
+  MembraneLoads loads_;
+  MembraneReferenceGeometry geometry_;
+  MembraneElementData data_;
+  MembraneLineItems lines_;
+  CsrAssemblyMap map_;
+  CsrMatrix K_, M_, Kdamp_;
+  MembraneConstraints constraints_;
+  MembraneCg cg_;
+  ExecSpace exec_;
+
+  lid_t nItems_ = 0;
+  real lchar_ = 1;
+  real time_ = 0;
+  bool haveAcceleration_ = false;
+  bool haveMass_ = false;
+  MembraneSolveReport last_;
+
+  ItemValuesView itemVec_, itemExt_, itemMat_;
+  RealView u_, v_, a_, R_, Fext_, du_, uTrial_, work_, work2_, rn_, lumpedMass_, pNode_, offsetSign_;
+  RealView a1_, v1_, rhs_, dampingForce_;  ///< time-step work vectors
+  RealView pElem_, pElemScaled_;  ///< element pressure in use (the load field, or a scaled copy)
+  // Clamps: node ids, reference-frame targets at the requested time, start values of a load ramp.
+  IndexView clampNodes_;
+  Kokkos::View<real* [3], MemSpace> clampTarget_, clampStart_;
+  std::vector<std::pair<int, lid_t>> clampHost_;  ///< (clamp group, node)
+};
+
+}  // namespace mfsi
