@@ -6,7 +6,7 @@
 
 namespace mfsi {
 
-/// Levenshtein edit distance (case-sensitive).
+/// Edit distance (case-sensitive): insertions, deletions, substitutions, adjacent transpositions.
 int editDistance(const std::string& a, const std::string& b);
 
 /// The closest candidate when it is close enough to be a plausible typo, else "".

@@ -1,5 +1,7 @@
 #include "coupling/Module.hpp"
 
+#include "coupling/FluidModule.hpp"
+#include "coupling/MembraneModule.hpp"
 #include "coupling/RigidModule.hpp"
 
 namespace mfsi {
@@ -17,7 +19,7 @@ const std::map<std::string, int>& Module::constructionCounts() { return counts()
 
 const std::vector<ModuleEntry>& moduleCatalogue() {
   // Physics modules register here as they land (fluid, membranes, bodies, coupling).
-  static const std::vector<ModuleEntry> catalogue = {rigidModuleEntry()};
+  static const std::vector<ModuleEntry> catalogue = {fluidModuleEntry(), membraneModuleEntry(), rigidModuleEntry()};
   return catalogue;
 }
 

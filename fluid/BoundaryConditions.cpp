@@ -105,6 +105,14 @@ BoundaryConditions::BoundaryConditions(const HexMesh& mesh, const FluidOptions& 
     MFSI_CHECK(!(rp.bc.timeFunction.kind != TimeFunction::Kind::Constant &&
                  rp.bc.timeFunction.kind != TimeFunction::Kind::Function && !(rp.bc.timeFunction.period > 0)),
                "fluid: patch '" << rp.name << "': time function period must be positive");
+    if (rp.bc.timeFunction.kind == TimeFunction::Kind::HalfPowerSine) {
+      const TimeFunction& tf = rp.bc.timeFunction;
+      MFSI_CHECK(tf.pulseDuration >= 0 && tf.pulseDuration <= tf.period,
+                 "fluid: patch '" << rp.name << "': half-power sine pulse duration " << tf.pulseDuration
+                                  << " must be in (0, period = " << tf.period << "] (0: period / 2)");
+      MFSI_CHECK(tf.exponent > 0, "fluid: patch '" << rp.name << "': half-power sine exponent must be positive, got "
+                                                   << tf.exponent);
+    }
     if (rp.type == BoundaryType::FixedPressure || rp.type == BoundaryType::Resistance) fixesPressure_ = true;
     // Bounding box of the patch nodes (reference configuration).
     rp.boxMin = {1e300, 1e300, 1e300};

@@ -1,5 +1,6 @@
 #include "fluid/FluidOptions.hpp"
 
+#include <algorithm>
 #include <cmath>
 
 namespace mfsi::fluid {
@@ -11,6 +12,14 @@ real TimeFunction::operator()(real t) const {
     case Kind::OneMinusCos: return 1.0 - std::cos(2.0 * pi * t / period);
     case Kind::CosineRamp: return t < period ? 0.5 * (1.0 - std::cos(pi * t / period)) : 1.0;
     case Kind::Function: return fn ? fn(t) : 1.0;
+    case Kind::HalfPowerSine: {
+      const real tp = pulseDuration > 0 ? pulseDuration : 0.5 * period;
+      real tau = std::fmod(t, period);
+      if (tau < 0) tau += period;
+      if (tau >= tp) return 0.0;
+      // max(): sin may round to a tiny negative value at tau ~ tp, which a fractional power turns into NaN.
+      return std::pow(std::max(std::sin(pi * tau / tp), real(0)), exponent);
+    }
   }
   return 1.0;
 }

@@ -72,10 +72,18 @@ struct TimeFunction {
     OneMinusCos,  ///< f = 1 - cos(2 pi t / period)
     CosineRamp,   ///< f = (1 - cos(pi t / period)) / 2 for t < period, then 1
     Function,     ///< f = fn(t)
+    /// Half-power sine pulse (ventricular-assist-device inflow): with tau = t mod period,
+    /// f = sin(pi tau / pulseDuration)^exponent for tau < pulseDuration, else 0. The amplitude A is
+    /// the boundary value the function multiplies (velocity, flow rate or pressure).
+    HalfPowerSine,
   };
   Kind kind = Kind::Constant;
   real period = 1.0;
   std::function<real(real)> fn;
+  /// HalfPowerSine: duration Tp of the pulse within one period, in (0, period]; 0 means period / 2.
+  real pulseDuration = 0.0;
+  /// HalfPowerSine: exponent p of the sine (> 0); 0.5 gives the "half-power" sine.
+  real exponent = 0.5;
 
   /// \brief Value at time t.
   real operator()(real t) const;
@@ -134,6 +142,14 @@ struct PimpleOptions {
   bool ddtCorrection = true;
 };
 
+/// \brief Artificial (weak) compressibility of the continuity equation: (1 / (rho c^2)) dp/dt +
+/// div(u) = 0 with an artificial sound speed c. Damps the added-mass instability of partitioned
+/// FSI with enclosed or nearly enclosed fluids, and makes the pressure level well defined without
+/// a pressure boundary. c -> infinity recovers the incompressible equations.
+struct ArtificialCompressibilityOptions {
+  real soundSpeed = 0.0;  ///< c [m/s]; 0 switches the term off (incompressible). Ignored when steady.
+};
+
 /// \brief All options of `FluidSolver`.
 struct FluidOptions {
   real density = 1.0;    ///< rho [kg/m^3]
@@ -158,6 +174,7 @@ struct FluidOptions {
   real pressureReferenceValue = 0;
   Vec3 initialVelocity{0, 0, 0};
   real initialPressure = 0;
+  ArtificialCompressibilityOptions artificialCompressibility;
   /// Boundary condition per patch name (patches of kind wall/symmetry/empty/baffle may be omitted).
   std::map<std::string, PatchBC> boundaries;
 };

@@ -41,6 +41,9 @@ FluidSolver::FluidSolver(const HexMesh& mesh, const FluidOptions& options)
              "fluid: relaxPressure must be in (0, 1]");
   MFSI_CHECK(opt_.pressureReferenceCell >= 0 && opt_.pressureReferenceCell < nCells_,
              "fluid: pressureReferenceCell " << opt_.pressureReferenceCell << " is not a cell of the mesh");
+  MFSI_CHECK(opt_.artificialCompressibility.soundSpeed >= 0,
+             "fluid: artificialCompressibility.soundSpeed must be >= 0 (0: off), got "
+                 << opt_.artificialCompressibility.soundSpeed);
   ScopedRegion region("mfsi::fluid::setup");
 
   geo_ = allocateGeometry(mesh);
@@ -58,6 +61,8 @@ FluidSolver::FluidSolver(const HexMesh& mesh, const FluidOptions& options)
   U00_ = Real3View("mfsi::fluid::U00", nCells_);
   p_ = RealView("mfsi::fluid::p", nCells_);
   pPrev_ = RealView("mfsi::fluid::pPrevIter", nCells_);
+  p0_ = RealView("mfsi::fluid::p0", nCells_);
+  p00_ = RealView("mfsi::fluid::p00", nCells_);
   V0_ = RealView("mfsi::fluid::V0", nCells_);
   V00_ = RealView("mfsi::fluid::V00", nCells_);
   HbyA_ = Real3View("mfsi::fluid::HbyA", nCells_);
@@ -100,6 +105,8 @@ FluidSolver::FluidSolver(const HexMesh& mesh, const FluidOptions& options)
         U(c, 2) = u0z;
       });
   Kokkos::deep_copy(exec_, p_, opt_.initialPressure);
+  Kokkos::deep_copy(exec_, p0_, opt_.initialPressure);
+  Kokkos::deep_copy(exec_, p00_, opt_.initialPressure);
   computeTimeCoefficients();
   bc_.update(exec_, 0.0, geo_, faceMeshVel_);
   setVelocity(U_);
@@ -158,11 +165,13 @@ void FluidSolver::beginStep(real t, real dt) {
     Kokkos::deep_copy(exec_, V00_, V0_);
     Kokkos::deep_copy(exec_, sweptOld_, sweptNew_);
     Kokkos::deep_copy(exec_, dphi00_, dphi0_);
+    Kokkos::deep_copy(exec_, p00_, p0_);
     bdf2Active_ = opt_.timeScheme == TimeScheme::BDF2;
   }
   Kokkos::deep_copy(exec_, U0_, U_);
   Kokkos::deep_copy(exec_, V0_, geo_.cellVolume);
   Kokkos::deep_copy(exec_, dphi0_, dphi_);
+  Kokkos::deep_copy(exec_, p0_, p_);
   Kokkos::deep_copy(exec_, sweptNew_, 0.0);
   Kokkos::deep_copy(exec_, faceMeshVel_, 0.0);
   Kokkos::deep_copy(exec_, points0_, mesh_.points());
@@ -543,10 +552,36 @@ void FluidSolver::assemblePressure() {
           }
         }
       });
-  Kokkos::deep_copy(exec_, cellDiag_, 0.0);
+  const bool ac = compressible();
+  if (ac) {
+    // Artificial compressibility: the linearised mass balance of a fluid with density
+    // rho + p / c^2 in a moving cell, d(V p)/dt / (rho c^2) + sum_f phi_f = 0 (the rho part cancels
+    // against the mesh fluxes by space conservation). The time derivative uses the momentum
+    // scheme's volume-weighted weights, so a closed box conserves sum(V p) / (rho c^2) + V exactly.
+    // The solve is for p itself (not a correction), so the old levels go to the right-hand side.
+    const real c = opt_.artificialCompressibility.soundSpeed;
+    const real k = 1.0 / (opt_.density * c * c * dt_), c1 = c1_;
+    ConstRealView V = geo_.cellVolume;
+    auto cd = cellDiag_;
+    Kokkos::parallel_for(
+        "mfsi::fluid::pressure::compressibilityDiag", RangePolicy(exec_, 0, nCells_),
+        KOKKOS_LAMBDA(lid_t c) { cd(c) = k * c1 * V(c); });
+  } else {
+    Kokkos::deep_copy(exec_, cellDiag_, 0.0);
+  }
   assembleMatrix(exec_, mesh_, sparsity_, fcP_, cellDiag_, Ap_, opt_.reduction);
   divergence<1>(exec_, mesh_, fluxP_, rhsP_, opt_.reduction, /*accumulate=*/false, /*sign=*/-1.0);
-  if (!bc_.fixesPressureLevel()) {
+  if (ac) {
+    const real c = opt_.artificialCompressibility.soundSpeed;
+    const real k = 1.0 / (opt_.density * c * c * dt_), c0 = c0_, c00 = c00_;
+    ConstRealView V0 = V0_, V00 = V00_, p0 = p0_, p00 = p00_;
+    auto rhs = rhsP_;
+    Kokkos::parallel_for(
+        "mfsi::fluid::pressure::compressibilitySource", RangePolicy(exec_, 0, nCells_),
+        KOKKOS_LAMBDA(lid_t c) { rhs(c) += k * (c0 * V0(c) * p0(c) - c00 * V00(c) * p00(c)); });
+  }
+  // With artificial compressibility the matrix is regular and the level is physical: no pinning.
+  if (!bc_.fixesPressureLevel() && !ac) {
     // No boundary sets the level: doubling one diagonal entry (and adding the matching source)
     // pins p at the reference cell without changing the other equations.
     const lid_t ref = opt_.pressureReferenceCell;
@@ -604,6 +639,10 @@ void FluidSolver::correctFluxAndVelocity() {
         });
   }
   updateBoundaryVelocity();
+}
+
+bool FluidSolver::compressible() const {
+  return opt_.artificialCompressibility.soundSpeed > 0 && opt_.timeScheme != TimeScheme::Steady;
 }
 
 void FluidSolver::storeDdtCorrection() {

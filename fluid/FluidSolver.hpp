@@ -5,7 +5,7 @@
 ///
 /// Discretisation (integral form over a moving cell of volume V):
 ///   rho d(V u)/dt + sum_f rho (phi_f - phi^m_f) u_f - mu sum_f (grad u)_f . S_f = -V grad p + rho V g,
-///   sum_f phi_f = 0,
+///   sum_f phi_f = 0     (or, with artificial compressibility c: d(V p)/dt / (rho c^2) + sum_f phi_f = 0),
 /// phi_f the absolute volumetric face flux and phi^m_f the mesh flux built from face swept volumes
 /// (see fluid/MeshFlux.hpp) with the time scheme's own weights, so that
 ///   (c1 V^{n+1} - c0 V^n + c00 V^{n-1}) / dt = sum_f phi^m_f      (discrete space conservation)
@@ -49,6 +49,7 @@ struct StepResult {
   real finalMomentumResidual = 0;  ///< initial residual of the momentum solve of the last outer iteration
   real finalPressureResidual = 0;  ///< initial residual of the first pressure solve of the last outer iteration
   real continuityMax = 0;  ///< max over cells of |sum_f phi_f| / V  [1/s] after the last corrector
+                           ///< (with artificial compressibility: the compression rate, not a residual)
   real continuitySum = 0;  ///< sum over cells of |sum_f phi_f|  [m^3/s]
 };
 
@@ -128,6 +129,7 @@ class FluidSolver {
   void computePhiHbyA();
   void assemblePressure();
   void correctFluxAndVelocity();
+  bool compressible() const;
   void storeDdtCorrection();
   real continuityMax(real& sum);
   bool fieldsFinite();
@@ -147,7 +149,7 @@ class FluidSolver {
 
   // Cell fields.
   Real3View U_, U0_, U00_;
-  RealView p_, pPrev_;
+  RealView p_, pPrev_, p0_, p00_;  ///< p0_, p00_: old time levels (artificial compressibility)
   RealView V0_, V00_;
   Real3View HbyA_, gradP_, rhsU_, bodyU_;
   Tensor3View gradU_;

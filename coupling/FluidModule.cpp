@@ -1,0 +1,139 @@
+#include "coupling/FluidModule.hpp"
+
+#include "fluid/GhiaTable.hpp"
+#include "fluid/Loads.hpp"
+
+#include <cmath>
+
+namespace mfsi {
+
+using namespace fluid;
+
+namespace {
+
+// Pressure at a point: on a patch, the boundary values of the two nearest faces blended by inverse
+// distance (they are extrapolated from the wall cells); otherwise the value of the nearest cell.
+double pressureAt(const FluidSolver& fluid, const Vec3& x, const std::string& patch) {
+  const HexMesh& mesh = fluid.mesh();
+  auto dist = [&](const auto& C, int i) {
+    return std::sqrt((C(i, 0) - x[0]) * (C(i, 0) - x[0]) + (C(i, 1) - x[1]) * (C(i, 1) - x[1]) +
+                     (C(i, 2) - x[2]) * (C(i, 2) - x[2]));
+  };
+  if (patch.empty()) {
+    auto C = Kokkos::create_mirror_view_and_copy(HostSpace(), fluid.geometry().cellCentroid);
+    auto p = Kokkos::create_mirror_view_and_copy(HostSpace(), fluid.pressure());
+    int best = 0;
+    for (int c = 1; c < mesh.nCells(); ++c)
+      if (dist(C, c) < dist(C, best)) best = c;
+    return p(best);
+  }
+  const auto& pt = mesh.patches()[mesh.patchIndex(patch)];
+  auto fc = Kokkos::create_mirror_view_and_copy(HostSpace(), fluid.geometry().faceCentroid);
+  auto pb = Kokkos::create_mirror_view_and_copy(HostSpace(), fluid.boundaryPressure());
+  const int nIn = mesh.nInternalFaces();
+  int f1 = -1, f2 = -1;
+  double d1 = 1e300, d2 = 1e300;
+  for (int f = pt.start; f < pt.start + pt.size; ++f) {
+    const double d = dist(fc, f);
+    if (d < d1) {
+      f2 = f1;
+      d2 = d1;
+      f1 = f;
+      d1 = d;
+    } else if (d < d2) {
+      f2 = f;
+      d2 = d;
+    }
+  }
+  if (f2 < 0 || d1 < 1e-12) return pb(f1 - nIn);
+  return (pb(f1 - nIn) / d1 + pb(f2 - nIn) / d2) / (1 / d1 + 1 / d2);
+}
+
+double dot(const Vec3& a, const Vec3& b) { return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]; }
+
+}  // namespace
+
+FluidModule::FluidModule(const HexMesh& mesh, const FluidOptions& options, FluidReports reports)
+    : Module("fluid"), solver_(mesh, options), reports_(std::move(reports)) {}
+
+void FluidModule::advance(const TimeState& t) {
+  last_ = solver_.solveStep(t.time, t.dt);
+  outerTotal_ += last_.outerIterations;
+  pressureTotal_ += last_.pressureIterations;
+  momentumTotal_ += last_.momentumIterations;
+  if (!last_.ok || !std::isfinite(last_.continuityMax) || !std::isfinite(last_.finalMomentumResidual))
+    throw DivergenceError("fluid: solver breakdown or non-finite fields in the step from t = " + std::to_string(t.time) +
+                          " (dt = " + std::to_string(t.dt) + "): reduce the time step or the relaxation factors");
+}
+
+std::vector<std::string> FluidModule::stepColumns() const {
+  return {"outerIterations",  "momentumIterations",   "pressureIterations",   "continuityMax",
+          "momentumResidual", "pressureResidual",     "finalMomentumResidual", "finalPressureResidual"};
+}
+
+void FluidModule::appendStepValues(std::vector<double>& v) const {
+  v.insert(v.end(), {double(last_.outerIterations), double(last_.momentumIterations), double(last_.pressureIterations),
+                     last_.continuityMax, last_.momentumResidual, last_.pressureResidual, last_.finalMomentumResidual,
+                     last_.finalPressureResidual});
+}
+
+void FluidModule::addMetrics(std::map<std::string, double>& m) const {
+  m["fluid.continuity_max"] = last_.continuityMax;
+  m["fluid.continuity_sum"] = last_.continuitySum;
+  m["fluid.outer_iterations"] = double(outerTotal_);
+  m["fluid.momentum_iterations"] = double(momentumTotal_);
+  m["fluid.pressure_iterations"] = double(pressureTotal_);
+  m["fluid.final_momentum_residual"] = last_.finalMomentumResidual;
+  m["fluid.final_pressure_residual"] = last_.finalPressureResidual;
+  m["fluid.converged"] = last_.converged ? 1.0 : 0.0;
+  {
+    auto U = Kokkos::create_mirror_view_and_copy(HostSpace(), solver_.velocity());
+    double umax = 0;
+    for (int c = 0; c < static_cast<int>(U.extent(0)); ++c)
+      umax = std::max(umax, std::sqrt(U(c, 0) * U(c, 0) + U(c, 1) * U(c, 1) + U(c, 2) * U(c, 2)));
+    m["fluid.max_velocity"] = umax;
+  }
+  const double rho = solver_.options().density;
+  for (const auto& f : reports_.forces) {
+    const PatchLoads L = patchLoads(solver_, f.patch, f.point);
+    const std::string k = "fluid." + f.patch + ".";
+    const char* xyz[3] = {"x", "y", "z"};
+    for (int d = 0; d < 3; ++d) {
+      m[k + "force_" + xyz[d]] = L.force[d];
+      m[k + "pressure_force_" + xyz[d]] = L.pressureForce[d];
+      m[k + "viscous_force_" + xyz[d]] = L.viscousForce[d];
+      m[k + "moment_" + xyz[d]] = L.moment[d];
+    }
+    if (f.referenceVelocity > 0) {
+      const double q = 0.5 * rho * f.referenceVelocity * f.referenceVelocity * f.referenceArea;
+      m[k + "c_D"] = dot(L.force, f.dragDirection) / q;
+      m[k + "c_L"] = dot(L.force, f.liftDirection) / q;
+    }
+  }
+  for (const auto& p : reports_.pressureDifferences)
+    m["fluid." + p.name] = pressureAt(solver_, p.from, p.patch) - pressureAt(solver_, p.to, p.patch);
+  if (reports_.ghia.enabled) {
+    const GhiaErrors e = ghiaErrors(solver_, reports_.ghia.re, reports_.ghia.lidSpeed);
+    m["fluid.ghia_u_max_err"] = e.uMax;
+    m["fluid.ghia_v_max_err"] = e.vMax;
+  }
+}
+
+ModuleEntry fluidModuleEntry() {
+  return {"fluid", &fluidSchema, [](const SceneConfig& section, SimulationContext& ctx) {
+            if (!ctx.mesh)
+              throw InputError(section.where(), "the fluid needs a 'mesh' section (the scene has none)");
+            const FluidOptions o = readFluidOptions(section, *ctx.mesh);
+            FluidReports r = readFluidReports(section, *ctx.mesh, o);
+            std::vector<std::unique_ptr<Module>> v;
+            try {
+              v.push_back(std::make_unique<FluidModule>(*ctx.mesh, o, std::move(r)));
+            } catch (const InputError& e) {
+              // Solver-side checks (inconsistent boundary options) carry no scene location.
+              throw InputError(section.where(), e.what());
+            }
+            return v;
+          }};
+}
+
+}  // namespace mfsi

@@ -1,0 +1,38 @@
+#pragma once
+/// \file
+/// \brief The `fluid` section as a module of a run: the incompressible flow solver on the scene
+/// mesh, with the reports the scene asks for (patch forces, pressure differences, Ghia check).
+#include "coupling/Module.hpp"
+#include "fluid/FluidConfig.hpp"
+#include "fluid/FluidSolver.hpp"
+
+namespace mfsi {
+
+class FluidModule final : public Module {
+ public:
+  /// Solver on `mesh` (which must outlive the module) with `options`; `reports` name what
+  /// addMetrics computes.
+  FluidModule(const HexMesh& mesh, const fluid::FluidOptions& options, FluidReports reports);
+  /// One time step (steady: `pimple.outerCorrectors` SIMPLE iterations). Throws DivergenceError
+  /// when the solver reports a breakdown or non-finite fields.
+  void advance(const TimeState& t) override;
+  /// fluid.* numbers: continuity, iteration totals, last residuals, forces, pressure differences,
+  /// Ghia errors.
+  void addMetrics(std::map<std::string, double>& metrics) const override;
+  std::vector<std::string> stepColumns() const override;
+  void appendStepValues(std::vector<double>& values) const override;
+
+  fluid::FluidSolver& solver() { return solver_; }
+  const fluid::StepResult& lastStep() const { return last_; }
+
+ private:
+  fluid::FluidSolver solver_;
+  FluidReports reports_;
+  fluid::StepResult last_;
+  long long outerTotal_ = 0, pressureTotal_ = 0, momentumTotal_ = 0;
+};
+
+/// Catalogue entry of the `fluid` section (needs the scene's `mesh`).
+ModuleEntry fluidModuleEntry();
+
+}  // namespace mfsi

@@ -1,0 +1,137 @@
+#include "coupling/MembraneModule.hpp"
+
+#include <cmath>
+
+namespace mfsi {
+
+namespace {
+const double kPi = std::acos(-1.0);
+
+/// Mean period from the zero crossings (linear interpolation) of a signal sampled every dt; 0
+/// with fewer than three crossings.
+double periodFromZeroCrossings(const std::vector<double>& w, double dt) {
+  std::vector<double> t;
+  for (std::size_t k = 0; k + 1 < w.size(); ++k)
+    if ((w[k] > 0) != (w[k + 1] > 0)) t.push_back(dt * (k + w[k] / (w[k] - w[k + 1])));
+  if (t.size() < 3) return 0;
+  return 2 * (t.back() - t.front()) / (t.size() - 1);
+}
+}  // namespace
+
+MembraneModule::MembraneModule(const MembranePanelOptions& options) : Module(options.name), panel_(options) {
+  const MembraneMesh mesh = buildMembraneMesh(generateMembraneMesh(panel_.mesh));
+  solver_ = std::make_unique<MembraneSolver>(mesh, panel_.options, resolveMembraneBoundary(panel_.boundary, mesh),
+                                             panel_.loads);
+  centre_ =
+      mesh.hasNodeSet("centre") && !mesh.nodeSet("centre").empty() ? mesh.nodeSet("centre").front() : mesh.centreNode();
+  centreNormal_ = mesh.hostNodeNormals()[centre_];
+
+  const MembraneInitialSpec& init = panel_.initial;
+  if (init.shape == MembraneInitialShape::SineMode) {
+    // w = A sin(m pi x / lx) sin(n pi y / ly) along the normal (+z) of the flat rectangle.
+    const MembraneRectangleSpec& r = panel_.mesh.rectangle;
+    auto u = Kokkos::create_mirror_view(solver_->displacement());
+    Kokkos::deep_copy(u, 0.0);
+    for (lid_t i = 0; i < mesh.nNodes(); ++i) {
+      const auto& X = mesh.hostPoints()[i];
+      u(3 * i + 2) = init.amplitude * std::sin(init.mode[0] * kPi * (X[0] - r.origin[0]) / r.lx) *
+                     std::sin(init.mode[1] * kPi * (X[1] - r.origin[1]) / r.ly);
+    }
+    Kokkos::deep_copy(solver_->displacement(), u);
+    solver_->resetDynamics();
+  }
+  sample();
+}
+
+void MembraneModule::sample() {
+  const auto u = Kokkos::create_mirror_view_and_copy(HostSpace(), solver_->displacement());
+  const lid_t n = static_cast<lid_t>(u.extent(0) / 3);
+  real m2 = 0;
+  bool finite = true;
+  for (lid_t i = 0; i < n; ++i) {
+    const real a = u(3 * i) * u(3 * i) + u(3 * i + 1) * u(3 * i + 1) + u(3 * i + 2) * u(3 * i + 2);
+    finite = finite && std::isfinite(a);
+    m2 = std::max(m2, a);
+  }
+  if (!finite) throw DivergenceError(name() + ": non-finite displacement at t = " + std::to_string(solver_->time()));
+  maxU_ = std::sqrt(m2);
+  centreW_ = 0;
+  for (int k = 0; k < 3; ++k) centreW_ += u(3 * centre_ + k) * centreNormal_[k];
+}
+
+void MembraneModule::check(const MembraneSolveReport& report, const char* what, double time) {
+  if (!report.converged || !std::isfinite(report.relativeResidual))
+    throw DivergenceError(name() + ": " + what + " did not converge at t = " + std::to_string(time) + " (" +
+                          std::to_string(report.iterations) + " iterations, relative residual " +
+                          std::to_string(report.relativeResidual) + ")");
+  sample();
+}
+
+void MembraneModule::openOutput(const std::string& /*dir*/) {
+  if (panel_.analysis != MembraneAnalysis::Static || solved_) return;
+  check(solver_->solveStatic(0), "static solve", 0);
+  solved_ = true;
+}
+
+void MembraneModule::advance(const TimeState& t) {
+  if (panel_.analysis == MembraneAnalysis::Static) {
+    check(solver_->solveStatic(t.time + t.dt), "static solve", t.time + t.dt);
+    solved_ = true;
+    return;
+  }
+  if (history_.empty()) {
+    history_.push_back(centreW_);
+    dt_ = t.dt;
+  }
+  solver_->setTime(t.time);
+  check(solver_->step(t.dt), "time step", t.time + t.dt);
+  // The period estimate assumes equal steps; a shorter last step ends the sampled record.
+  if (std::abs(t.dt - dt_) <= 1e-12 * dt_) history_.push_back(centreW_);
+}
+
+std::vector<std::string> MembraneModule::stepColumns() const {
+  return {"iterations", "residual", "maxDisplacement", "centreDeflection"};
+}
+
+void MembraneModule::appendStepValues(std::vector<double>& values) const {
+  const MembraneSolveReport& r = solver_->lastReport();
+  values.push_back(r.iterations);
+  values.push_back(r.relativeResidual);
+  values.push_back(maxU_);
+  values.push_back(centreW_);
+}
+
+void MembraneModule::addMetrics(std::map<std::string, double>& metrics) const {
+  const std::string p = name() + ".";
+  for (const auto& [k, v] : solver_->summary()) metrics[p + k] = v;
+  const MembraneMaterial& m = panel_.options.material;
+  if (panel_.reference == MembraneReference::Hencky) {
+    // Hencky: w0 = C_w(nu) a (p a / (E h))^(1/3), along the load.
+    const double a = panel_.mesh.disc.radius;
+    const double p0 =
+        panel_.loads.pressure * (panel_.loads.pressureTime ? panel_.loads.pressureTime(solver_->time()) : 1);
+    const double exact = henckyCoefficient(m.poissonRatio) * a * std::cbrt(p0 * a / (m.youngsModulus * m.thickness));
+    metrics[p + "hencky_w0"] = exact;
+    if (exact != 0) metrics[p + "hencky_rel_err"] = std::abs(centreW_ - exact) / std::abs(exact);
+  } else if (panel_.reference == MembraneReference::SquareFrequency) {
+    const MembraneRectangleSpec& r = panel_.mesh.rectangle;
+    const double f = rectangleMembraneFrequency(m.preStress, m.density * m.thickness, r.lx, r.ly,
+                                                panel_.initial.mode[0], panel_.initial.mode[1]);
+    const double period = periodFromZeroCrossings(history_, dt_);
+    metrics[p + "period_exact"] = 1 / f;
+    if (period > 0) {
+      metrics[p + "period"] = period;
+      metrics[p + "period_rel_err"] = std::abs(period * f - 1);
+    }
+  }
+}
+
+ModuleEntry membraneModuleEntry() {
+  return {"membranes", &membraneSchema, [](const SceneConfig& section, SimulationContext& ctx) {
+            std::vector<std::unique_ptr<Module>> v;
+            for (const auto& panel : readMembraneOptions(section, ctx.mesh)) v.push_back(std::make_unique<MembraneModule>(panel));
+            return v;
+          }};
+}
+
+}  // namespace mfsi

@@ -1,0 +1,52 @@
+#pragma once
+/// \file
+/// \brief The `membranes` section as modules of a run: one module per panel, named "membrane"
+/// (a single unnamed panel), "membrane.<name>" or "membrane.<index>".
+///
+/// Static analysis: equilibrium under the loads at t = 0 when the run starts (openOutput), then at
+/// the end time of every step (time functions of the loads make a load ramp). Dynamic analysis:
+/// one implicit step per run step from the initial shape. Either throws DivergenceError when a
+/// solve does not converge or the state is not finite.
+#include "coupling/Module.hpp"
+#include "structure/MembraneConfig.hpp"
+#include "structure/MembraneSolver.hpp"
+
+#include <memory>
+
+namespace mfsi {
+
+class MembraneModule final : public Module {
+ public:
+  explicit MembraneModule(const MembranePanelOptions& options);
+
+  void advance(const TimeState& t) override;
+  /// "<name>.<summary key>" for every entry of MembraneSolver::summary(), and the comparison with
+  /// the reference solution: hencky_w0 and hencky_rel_err, or period, period_exact and period_rel_err.
+  void addMetrics(std::map<std::string, double>& metrics) const override;
+  /// Solves the t = 0 equilibrium of a static panel (the run is starting).
+  void openOutput(const std::string& dir) override;
+  std::vector<std::string> stepColumns() const override;
+  void appendStepValues(std::vector<double>& values) const override;
+
+  MembraneSolver& solver() { return *solver_; }
+  const MembranePanelOptions& panel() const { return panel_; }
+
+ private:
+  void check(const MembraneSolveReport& report, const char* what, double time);
+  void sample();  ///< max |u| and centre deflection of the current state
+
+  MembranePanelOptions panel_;
+  std::unique_ptr<MembraneSolver> solver_;
+  lid_t centre_ = 0;
+  std::array<real, 3> centreNormal_{0, 0, 1};
+  bool solved_ = false;
+  real maxU_ = 0;
+  real centreW_ = 0;
+  std::vector<double> history_;  ///< centre deflection at t = 0, dt, 2 dt, ... (dynamic)
+  double dt_ = 0;
+};
+
+/// Catalogue entry of the `membranes` section.
+ModuleEntry membraneModuleEntry();
+
+}  // namespace mfsi

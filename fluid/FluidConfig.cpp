@@ -1,0 +1,325 @@
+#include "fluid/FluidConfig.hpp"
+
+#include "core/Suggest.hpp"
+#include "fluid/GhiaTable.hpp"
+
+#include <cmath>
+
+namespace mfsi {
+
+using namespace fluid;
+
+namespace {
+
+const std::vector<std::string> kBoundaryTypes = {"fixedVelocity", "flowRate", "wall",          "movingWall",
+                                                 "slip",          "empty",    "fixedPressure", "resistance"};
+
+Schema linearSolverSchema(const std::string& what, double tolerance, int maxIter) {
+  return Schema::map(what + " linear solver: stops at scaled residual < tolerance, residual reduced by relTol, or maxIter")
+      .key("tolerance", Schema::real("absolute tolerance on the scaled residual", "-").atLeast(0), Default(tolerance))
+      .key("relTol", Schema::real("relative reduction of the residual (0: off)", "-").atLeast(0).lessThan(1), Default(0.0))
+      .key("maxIter", Schema::integer("iteration limit per solve").atLeast(1), Default(maxIter));
+}
+
+Schema boundarySchema() {
+  return Schema::map("boundary condition of a patch (or of both sides of a baffle)")
+      .key("type",
+           Schema::choice("fixedVelocity: prescribed velocity; flowRate: volumetric inflow along the inward normal; "
+                          "wall: no-slip, tangential velocity `velocity` (a driven lid); movingWall: no-slip moving "
+                          "with the mesh; slip: free slip / symmetry; empty: front/back of a one-cell-thick 2D mesh; "
+                          "fixedPressure: p prescribed, zero-gradient velocity (outflow); resistance: p = resistance * "
+                          "q + pressure, q the outflow rate",
+                          kBoundaryTypes))
+      .key("velocity", Schema::realVector(3, "fixedVelocity: value (peak of a parabolic profile); wall: wall velocity", "m/s"),
+           Default(std::array<double, 3>{0, 0, 0}))
+      .key("flowRate", Schema::real("flowRate: volumetric inflow, positive into the domain", "m^3/s"), Default(0.0))
+      .key("pressure", Schema::real("fixedPressure: p; resistance: p0", "Pa"), Default(0.0))
+      .key("resistance", Schema::real("resistance: C_r", "Pa s/m^3").atLeast(0), Default(0.0))
+      .key("profile", Schema::choice("fixedVelocity/flowRate: shape across the patch; parabolic = prod 4 s (1 - s)",
+                                     {"uniform", "parabolic"}),
+           Default("uniform"))
+      .key("parabolicAxes", Schema::list("parabolic: axes the profile varies across", Schema::choice("axis", {"x", "y", "z"})),
+           Presence::Optional)
+      .key("parabolicMin", Schema::realVector(3, "parabolic: lower end of the extent per axis (min >= max: patch box)", "m"),
+           Default(std::array<double, 3>{0, 0, 0}))
+      .key("parabolicMax", Schema::realVector(3, "parabolic: upper end of the extent per axis", "m"),
+           Default(std::array<double, 3>{0, 0, 0}))
+      .key("timeFunction",
+           Schema::map("factor f(t) on the velocity, flow rate or pressure")
+               .key("type", Schema::choice("constant: 1; oneMinusCos: 1 - cos(2 pi t / period); cosineRamp: (1 - cos(pi t "
+                                           "/ period)) / 2 up to t = period, then 1; halfPowerSine: sin(pi tau / "
+                                           "pulseDuration)^exponent for tau = t mod period < pulseDuration, else 0",
+                                           {"constant", "oneMinusCos", "cosineRamp", "halfPowerSine"}),
+                    Default("constant"))
+               .key("period", Schema::real("period or ramp time", "s").greaterThan(0), Default(1.0))
+               .key("pulseDuration", Schema::real("halfPowerSine: pulse length (0: period / 2)", "s").atLeast(0),
+                    Default(0.0))
+               .key("exponent", Schema::real("halfPowerSine: exponent", "-").greaterThan(0), Default(0.5)),
+           Presence::Optional);
+}
+
+Schema forceSchema() {
+  return Schema::map("force and moment on a patch (or both sides of a baffle), metrics fluid.<patch>.*")
+      .key("patch", Schema::string("patch or baffle name"))
+      .key("point", Schema::realVector(3, "moment reference point", "m"), Default(std::array<double, 3>{0, 0, 0}))
+      .key("referenceVelocity", Schema::real("U of the coefficients c = 2 F.e / (rho U^2 A) (0: no coefficients)", "m/s")
+                                    .atLeast(0),
+           Default(0.0))
+      .key("referenceArea", Schema::real("A of the coefficients", "m^2").greaterThan(0), Default(1.0))
+      .key("dragDirection", Schema::realVector(3, "direction e of c_D", "-"), Default(std::array<double, 3>{1, 0, 0}))
+      .key("liftDirection", Schema::realVector(3, "direction e of c_L", "-"), Default(std::array<double, 3>{0, 1, 0}));
+}
+
+Schema pressureDifferenceSchema() {
+  return Schema::map("pressure difference p(from) - p(to), metric fluid.<name>")
+      .key("name", Schema::string("metric name"))
+      .key("from", Schema::realVector(3, "first point", "m"))
+      .key("to", Schema::realVector(3, "second point", "m"))
+      .key("patch", Schema::string("take boundary values on this patch ('': nearest cell values)"), Default(""));
+}
+
+Vec3 vec3(const SceneConfig& c, const std::string& key) { return c.get<std::array<double, 3>>(key); }
+
+// Names a boundary entry may use: patches, and baffles (both sides at once).
+std::vector<std::string> boundaryNames(const HexMesh& mesh) {
+  std::vector<std::string> names;
+  for (const auto& p : mesh.patches()) {
+    names.push_back(p.name);
+    const std::string suffix = "_master";
+    if (p.kind == PatchKind::BaffleMaster && p.name.size() > suffix.size())
+      names.push_back(p.name.substr(0, p.name.size() - suffix.size()));
+  }
+  return names;
+}
+
+void checkBoundaryName(const SceneConfig& c, const std::string& key, const std::string& name, const HexMesh& mesh) {
+  const auto names = boundaryNames(mesh);
+  if (std::find(names.begin(), names.end(), name) == names.end())
+    throw InputError(c.where(key), "the mesh has no patch or baffle named '" + name + "'" + didYouMean(name, names) +
+                                       "; patches: " + joinList(names));
+}
+
+PatchBC readBoundary(const SceneConfig& b) {
+  PatchBC bc;
+  const std::string type = b.get<std::string>("type");
+  if (type == "fixedVelocity") bc.type = BoundaryType::FixedVelocity;
+  if (type == "flowRate") bc.type = BoundaryType::FlowRate;
+  if (type == "wall" || type == "movingWall") bc.type = BoundaryType::Wall;
+  if (type == "movingWall") bc.wallMotion = WallMotion::MeshVelocity;
+  if (type == "slip") bc.type = BoundaryType::Slip;
+  if (type == "empty") bc.type = BoundaryType::Empty;
+  if (type == "fixedPressure") bc.type = BoundaryType::FixedPressure;
+  if (type == "resistance") bc.type = BoundaryType::Resistance;
+  bc.velocity = vec3(b, "velocity");
+  bc.flowRate = b.get<double>("flowRate");
+  bc.pressure = b.get<double>("pressure");
+  bc.resistance = b.get<double>("resistance");
+  bc.profile = b.get<std::string>("profile") == "parabolic" ? Profile::Parabolic : Profile::Uniform;
+  const auto axes = b.get<std::vector<std::string>>("parabolicAxes");
+  for (const auto& a : axes) bc.parabolicAxes[a[0] - 'x'] = true;
+  if (bc.profile == Profile::Parabolic && axes.empty())
+    throw InputError(b.where("profile"), "a parabolic profile needs 'parabolicAxes' (e.g. [y])");
+  if (bc.profile == Profile::Parabolic && bc.type != BoundaryType::FixedVelocity && bc.type != BoundaryType::FlowRate)
+    throw InputError(b.where("profile"), "a parabolic profile applies to fixedVelocity and flowRate patches only");
+  bc.parabolicMin = vec3(b, "parabolicMin");
+  bc.parabolicMax = vec3(b, "parabolicMax");
+  if (b.has("timeFunction")) {
+    const std::string tf = b.get<std::string>("timeFunction.type");
+    bc.timeFunction.kind = tf == "oneMinusCos"  ? TimeFunction::Kind::OneMinusCos
+                           : tf == "cosineRamp" ? TimeFunction::Kind::CosineRamp
+                           : tf == "halfPowerSine" ? TimeFunction::Kind::HalfPowerSine
+                                                : TimeFunction::Kind::Constant;
+    bc.timeFunction.period = b.get<double>("timeFunction.period");
+    bc.timeFunction.pulseDuration = b.get<double>("timeFunction.pulseDuration");
+    bc.timeFunction.exponent = b.get<double>("timeFunction.exponent");
+    if (bc.timeFunction.pulseDuration > bc.timeFunction.period)
+      throw InputError(b.where("timeFunction.pulseDuration"), "must not exceed the period");
+  }
+  return bc;
+}
+
+}  // namespace
+
+Schema fluidSchema() {
+  const FluidOptions d;  // defaults below mirror these
+  Schema pimple =
+      Schema::map("pressure-velocity coupling: PIMPLE per time step; SIMPLE iterations when steady")
+          .key("outerCorrectors", Schema::integer("outer iterations per step (SIMPLE iterations per step when steady)").atLeast(1),
+               Default(d.pimple.nOuterCorrectors))
+          .key("correctors", Schema::integer("pressure correctors per outer iteration (PISO)").atLeast(1),
+               Default(d.pimple.nCorrectors))
+          .key("nonOrthogonalCorrectors", Schema::integer("extra pressure solves for the non-orthogonal correction").atLeast(0),
+               Default(d.pimple.nNonOrthogonalCorrectors))
+          .key("momentumPredictor", Schema::boolean("solve the momentum equation before the pressure correctors"),
+               Default(d.pimple.momentumPredictor))
+          .key("outerTolerance",
+               Schema::real("stop the outer loop when the initial momentum and pressure residuals drop below (0: off)", "-")
+                   .atLeast(0),
+               Default(d.pimple.outerTolerance))
+          .key("relaxVelocity", Schema::real("implicit under-relaxation of momentum (~0.7-0.9 when steady)", "-")
+                                    .greaterThan(0)
+                                    .atMost(1),
+               Default(d.pimple.relaxVelocity))
+          .key("relaxPressure", Schema::real("explicit under-relaxation of pressure (~0.2-0.3 when steady)", "-")
+                                    .greaterThan(0)
+                                    .atMost(1),
+               Default(d.pimple.relaxPressure))
+          .key("ddtCorrection", Schema::boolean("Rhie-Chow correction of the time-derivative term"),
+               Default(d.pimple.ddtCorrection));
+  Schema pressure = linearSolverSchema("pressure", d.pressureSolver.tolerance, d.pressureSolver.maxIter);
+  pressure.key("preconditioner", Schema::choice("conjugate-gradient preconditioner", {"amg", "jacobi"}), Default("amg"))
+      .key("preconditionerRefresh", Schema::integer("outer iterations between AMG value refreshes").atLeast(1),
+           Default(d.pressurePreconditionerRefresh));
+  Schema solvers = Schema::map("linear solvers")
+                       .key("pressure", pressure, Presence::Optional)
+                       .key("momentum", linearSolverSchema("momentum", d.momentumSolver.tolerance, d.momentumSolver.maxIter),
+                            Presence::Optional);
+  return Schema::map("incompressible Navier-Stokes on the scene mesh (finite volumes, PIMPLE/SIMPLE)")
+      .key("density", Schema::real("density rho", "kg/m^3").greaterThan(0), Default(d.density))
+      .key("viscosity", Schema::real("dynamic viscosity mu (give this or nu)", "Pa s").greaterThan(0),
+           Presence::OptionalSection)
+      .key("nu", Schema::real("kinematic viscosity nu = mu / rho (give this or viscosity)", "m^2/s").greaterThan(0),
+           Presence::OptionalSection)
+      .key("bodyForce", Schema::realVector(3, "body acceleration g", "m/s^2"), Default(std::array<double, 3>{0, 0, 0}))
+      .key("artificialSoundSpeed",
+           Schema::real("artificial compressibility: (1/(rho c^2)) dp/dt + div u = 0; 0 = incompressible", "m/s")
+               .atLeast(0),
+           Default(d.artificialCompressibility.soundSpeed))
+      .key("timeScheme", Schema::choice("steady: SIMPLE; euler: implicit Euler; bdf2: second-order backward differences",
+                                        {"steady", "euler", "bdf2"}),
+           Default("bdf2"))
+      .key("convection", Schema::choice("face interpolation of the convected velocity", {"upwind", "linear", "limitedLinear",
+                                                                                          "vanLeer"}),
+           Default("linear"))
+      .key("gradient", Schema::choice("cell gradients", {"gaussLinear", "leastSquares"}), Default("gaussLinear"))
+      .key("pimple", pimple, Presence::Optional)
+      .key("solvers", solvers, Presence::Optional)
+      .key("initial", Schema::map("initial fields")
+                          .key("velocity", Schema::realVector(3, "uniform initial velocity", "m/s"),
+                               Default(std::array<double, 3>{0, 0, 0}))
+                          .key("pressure", Schema::real("uniform initial pressure", "Pa"), Default(0.0)),
+           Presence::Optional)
+      .key("boundary", Schema::freeMap("condition per patch name; wall, symmetry, empty and baffle patches may be omitted "
+                                       "(wall -> wall, symmetry -> slip, empty -> empty, baffle -> wall moved by a membrane)",
+                                       boundarySchema()),
+           Presence::Optional)
+      .key("forces", Schema::list("patches whose force and moment are reported", forceSchema()), Presence::Optional)
+      .key("pressureDifferences", Schema::list("pressure differences reported as metrics", pressureDifferenceSchema()),
+           Presence::Optional)
+      .key("ghia", Schema::map("compare a lid-driven cavity (mesh bounding box in x, y; lid at y max moving in +x) with "
+                               "Ghia, Ghia & Shin (1982): metrics fluid.ghia_u_max_err, fluid.ghia_v_max_err")
+                       .key("enabled", Schema::boolean("compute the comparison (false: skip, e.g. at another Re)"),
+                            Default(true))
+                       .key("re", Schema::choice("Reynolds number of the table; must equal rho U L / mu of the scene", {"100"}),
+                            Default("100"))
+                       .key("lidSpeed", Schema::real("lid speed U", "m/s").greaterThan(0), Default(1.0)),
+           Presence::OptionalSection);
+}
+
+FluidOptions readFluidOptions(const SceneConfig& c, const HexMesh& mesh) {
+  FluidOptions o;
+  o.density = c.get<double>("density");
+  const bool hasMu = c.has("viscosity"), hasNu = c.has("nu");
+  if (hasMu == hasNu)
+    throw InputError(c.where(hasMu ? "nu" : ""), hasMu ? "give either 'viscosity' (dynamic) or 'nu' (kinematic), not both"
+                                                        : "give the viscosity: 'viscosity' (dynamic, Pa s) or 'nu' "
+                                                          "(kinematic, m^2/s)");
+  o.viscosity = hasMu ? c.get<double>("viscosity") : c.get<double>("nu") * o.density;
+  o.bodyForce = vec3(c, "bodyForce");
+  o.artificialCompressibility.soundSpeed = c.get<double>("artificialSoundSpeed");
+  const std::string ts = c.get<std::string>("timeScheme");
+  o.timeScheme = ts == "steady" ? TimeScheme::Steady : ts == "euler" ? TimeScheme::Euler : TimeScheme::BDF2;
+  const std::string cs = c.get<std::string>("convection");
+  o.convection = cs == "upwind"          ? ConvectionScheme::Upwind
+                 : cs == "limitedLinear" ? ConvectionScheme::LimitedLinear
+                 : cs == "vanLeer"       ? ConvectionScheme::VanLeer
+                                         : ConvectionScheme::Linear;
+  o.gradient = c.get<std::string>("gradient") == "leastSquares" ? GradientScheme::LeastSquares : GradientScheme::GaussLinear;
+
+  o.pimple.nOuterCorrectors = c.get<int>("pimple.outerCorrectors");
+  o.pimple.nCorrectors = c.get<int>("pimple.correctors");
+  o.pimple.nNonOrthogonalCorrectors = c.get<int>("pimple.nonOrthogonalCorrectors");
+  o.pimple.momentumPredictor = c.get<bool>("pimple.momentumPredictor");
+  o.pimple.outerTolerance = c.get<double>("pimple.outerTolerance");
+  o.pimple.relaxVelocity = c.get<double>("pimple.relaxVelocity");
+  o.pimple.relaxPressure = c.get<double>("pimple.relaxPressure");
+  o.pimple.ddtCorrection = c.get<bool>("pimple.ddtCorrection");
+
+  auto solver = [&](const std::string& k) {
+    return LinearSolverOptions{c.get<double>(k + ".tolerance"), c.get<double>(k + ".relTol"), c.get<int>(k + ".maxIter")};
+  };
+  o.pressureSolver = solver("solvers.pressure");
+  o.momentumSolver = solver("solvers.momentum");
+  o.pressurePreconditioner = c.get<std::string>("solvers.pressure.preconditioner") == "jacobi"
+                                 ? PressurePreconditioner::Jacobi
+                                 : PressurePreconditioner::Amg;
+  o.pressurePreconditionerRefresh = c.get<int>("solvers.pressure.preconditionerRefresh");
+  o.initialVelocity = vec3(c, "initial.velocity");
+  o.initialPressure = c.get<double>("initial.pressure");
+
+  for (const auto& name : c.keys("boundary")) {
+    checkBoundaryName(c, "boundary." + name, name, mesh);
+    o.boundaries[name] = readBoundary(c.child("boundary." + name));
+  }
+  // Plain patches have no natural condition: name the missing key here rather than in the solver.
+  for (const auto& p : mesh.patches())
+    if (p.kind == PatchKind::Patch && !o.boundaries.count(p.name))
+      throw InputError(c.where("boundary"), "patch '" + p.name + "' needs a condition (key fluid.boundary." + p.name +
+                                                "; its mesh patch kind is 'patch', not wall/symmetry/empty)");
+  return o;
+}
+
+FluidReports readFluidReports(const SceneConfig& c, const HexMesh& mesh, const FluidOptions& options) {
+  FluidReports r;
+  for (std::size_t i = 0; i < c.size("forces"); ++i) {
+    const SceneConfig f = c.child("forces." + std::to_string(i));
+    ForceReport fr;
+    fr.patch = f.get<std::string>("patch");
+    checkBoundaryName(f, "patch", fr.patch, mesh);
+    fr.point = vec3(f, "point");
+    fr.referenceVelocity = f.get<double>("referenceVelocity");
+    fr.referenceArea = f.get<double>("referenceArea");
+    fr.dragDirection = vec3(f, "dragDirection");
+    fr.liftDirection = vec3(f, "liftDirection");
+    for (Vec3* e : {&fr.dragDirection, &fr.liftDirection}) {
+      const double n = std::sqrt((*e)[0] * (*e)[0] + (*e)[1] * (*e)[1] + (*e)[2] * (*e)[2]);
+      if (!(n > 0)) throw InputError(f.where(e == &fr.dragDirection ? "dragDirection" : "liftDirection"), "must be non-zero");
+      for (auto& x : *e) x /= n;
+    }
+    r.forces.push_back(fr);
+  }
+  for (std::size_t i = 0; i < c.size("pressureDifferences"); ++i) {
+    const SceneConfig p = c.child("pressureDifferences." + std::to_string(i));
+    PressureDifferenceReport pr;
+    pr.name = p.get<std::string>("name");
+    pr.from = vec3(p, "from");
+    pr.to = vec3(p, "to");
+    pr.patch = p.get<std::string>("patch");
+    if (!pr.patch.empty() && mesh.findPatch(pr.patch) < 0) {
+      std::vector<std::string> names;
+      for (const auto& mp : mesh.patches()) names.push_back(mp.name);
+      throw InputError(p.where("patch"), "the mesh has no patch named '" + pr.patch + "'" + didYouMean(pr.patch, names));
+    }
+    r.pressureDifferences.push_back(pr);
+  }
+  if (c.has("ghia") && c.get<bool>("ghia.enabled")) {
+    r.ghia.enabled = true;
+    r.ghia.re = std::stoi(c.get<std::string>("ghia.re"));
+    r.ghia.lidSpeed = c.get<double>("ghia.lidSpeed");
+    // Cavity width from the mesh: Re = rho U L / mu must be the table's.
+    auto P = Kokkos::create_mirror_view_and_copy(HostSpace(), mesh.referencePoints());
+    double lo = 1e300, hi = -1e300;
+    for (int n = 0; n < static_cast<int>(P.extent(0)); ++n) {
+      lo = std::min(lo, P(n, 0));
+      hi = std::max(hi, P(n, 0));
+    }
+    const double re = options.density * r.ghia.lidSpeed * (hi - lo) / options.viscosity;
+    if (std::abs(re / r.ghia.re - 1) > 1e-3)
+      throw InputError(c.where("ghia"), "the scene's Reynolds number rho U L / mu = " + formatReal(re) +
+                                            " differs from the table's " + std::to_string(r.ghia.re) +
+                                            " (set fluid.ghia.enabled=false to run without the comparison)");
+  }
+  return r;
+}
+
+}  // namespace mfsi

@@ -1,0 +1,38 @@
+#pragma once
+/// \file
+/// \brief Ghia, Ghia & Shin (1982) lid-driven cavity centreline velocities, compiled in so a scene
+/// can report its error against them without data files, and the comparison of a cavity solution
+/// with them.
+#include "fluid/FluidSolver.hpp"
+
+#include <vector>
+
+namespace mfsi::fluid {
+
+/// \brief One tabulated value: u / U_lid on the vertical centreline at height y / L (`uLine`), or
+/// v / U_lid on the horizontal centreline at x / L.
+struct GhiaPoint {
+  bool uLine;
+  double coord, value;
+};
+
+/// \brief Reynolds numbers with a compiled-in table.
+std::vector<int> ghiaReynoldsNumbers();
+
+/// \brief The table at Reynolds number `re` (empty when not compiled in).
+const std::vector<GhiaPoint>& ghiaTable(int re);
+
+/// \brief Largest deviation from the table on each centreline, in units of the lid speed.
+struct GhiaErrors {
+  double uMax = 0;  ///< max over the table's y of |u(x_c, y) / U_lid - u_Ghia|
+  double vMax = 0;  ///< max over the table's x of |v(x, y_c) / U_lid - v_Ghia|
+};
+
+/// \brief Compare a cavity solution with Ghia's table at `re`. The cavity is the bounding box of
+/// the mesh in x and y (lid at y max moving in +x with speed `lidSpeed`); the mesh must be a
+/// structured block of cell rows and columns (any grading). Centreline profiles are interpolated
+/// linearly between the two cell columns (rows) next to the centreline, completed by the wall
+/// values, and evaluated at Ghia's points by cubic Lagrange interpolation.
+GhiaErrors ghiaErrors(const FluidSolver& fluid, int re, double lidSpeed);
+
+}  // namespace mfsi::fluid
