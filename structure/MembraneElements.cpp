@@ -516,6 +516,8 @@ MembraneElementOutput allocateMembraneElementOutput(lid_t nElements) {
   o.principal2 = RealView("mfsi::structure::membrane::out::principal2", nElements);
   o.vonMises = RealView("mfsi::structure::membrane::out::vonMises", nElements);
   o.wrinkleState = Kokkos::View<int*, MemSpace>("mfsi::structure::membrane::out::wrinkleState", nElements);
+  o.gaussWrinkleState =
+      Kokkos::View<int* [4], MemSpace>("mfsi::structure::membrane::out::gaussWrinkleState", nElements);
   o.basis1 = Real3View("mfsi::structure::membrane::out::basis1", nElements);
   return o;
 }
@@ -551,6 +553,20 @@ void membraneElementOutput(const ExecSpace& exec, const MembraneElementData& dat
         o.principal2(e) = s2;
         o.vonMises(e) = kmath::sqrt(s1 * s1 - s1 * s2 + s2 * s2);
         o.wrinkleState(e) = static_cast<int>(state);
+        // The state at every Gauss point, where the element integrals sample the material law.
+        const real gq = 0.57735026918962576451;
+        const real gpx[4] = {-gq, gq, -gq, gq}, gpy[4] = {-gq, -gq, gq, gq};
+        for (int q = 0; q < 4; ++q) {
+          if (nv != 4 && q > 0) {
+            o.gaussWrinkleState(e, q) = -1;
+            continue;
+          }
+          const real a = nv == 4 ? gpx[q] : 1.0 / 3.0, b = nv == 4 ? gpy[q] : 1.0 / 3.0;
+          real Nq[4], dq[4][2], f1[3], f2[3], gg[2][3], Eq[3], Nfq[3], Cq[3][3];
+          localFrame(nv, X0, a, b, Nq, dq, f1, f2);
+          strainAt(nv, dq, x, gg, Eq);
+          o.gaussWrinkleState(e, q) = static_cast<int>(d.law.evaluate(Eq, Nfq, Cq));
+        }
       });
 }
 

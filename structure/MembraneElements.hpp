@@ -100,6 +100,9 @@ struct MembraneElementOutput {
   Kokkos::View<real* [3], MemSpace> stress;
   RealView principal1, principal2, vonMises;
   Kokkos::View<int*, MemSpace> wrinkleState;
+  /// Wrinkle state at each Gauss point (quads: the 2 x 2 points in the order (-,-), (+,-), (-,+),
+  /// (+,+); triangles: the centroid in slot 0 and -1 in the others).
+  Kokkos::View<int* [4], MemSpace> gaussWrinkleState;
   Real3View basis1;
 };
 

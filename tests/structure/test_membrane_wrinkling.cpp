@@ -115,7 +115,16 @@ PanelResult homogeneousPanel(const Eigen::Matrix2d& F, MembraneWrinklingModel mo
   auto S = Kokkos::create_mirror_view_and_copy(HostSpace(), res.elements.stress);
   auto s2 = Kokkos::create_mirror_view_and_copy(HostSpace(), res.elements.principal2);
   auto st = Kokkos::create_mirror_view_and_copy(HostSpace(), res.elements.wrinkleState);
+  auto gst = Kokkos::create_mirror_view_and_copy(HostSpace(), res.elements.gaussWrinkleState);
   for (lid_t e = 0; e < mesh.nElements(); ++e) {
+    // A homogeneous deformation: every Gauss point is in the element's state. (Not for slack
+    // panels: without stiffness their interior nodes need not sit at the homogeneous positions.)
+    const int nGauss = mesh.hostElements()[e][3] < 0 ? 1 : 4;
+    if (st(e) != static_cast<int>(MembraneWrinkleState::Slack)) {
+      for (int q = 0; q < nGauss; ++q) {
+        EXPECT_EQ(gst(e, q), st(e)) << "element " << e << " Gauss point " << q;
+      }
+    }
     r.S11.push_back(S(e, 0));
     r.S22.push_back(S(e, 1));
     r.S12.push_back(S(e, 2));
