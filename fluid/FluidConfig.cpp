@@ -167,7 +167,9 @@ Schema fluidSchema() {
           .key("ddtCorrection", Schema::boolean("Rhie-Chow correction of the time-derivative term"),
                Default(d.pimple.ddtCorrection));
   Schema pressure = linearSolverSchema("pressure", d.pressureSolver.tolerance, d.pressureSolver.maxIter);
-  pressure.key("preconditioner", Schema::choice("conjugate-gradient preconditioner", {"amg", "jacobi"}), Default("amg"))
+  pressure.key("finalRelTol", Schema::real("relTol of the last pressure solve of a step (pFinal; < 0: relTol)", "-").lessThan(1),
+               Default(d.pressureFinalRelTol))
+      .key("preconditioner", Schema::choice("conjugate-gradient preconditioner", {"amg", "jacobi"}), Default("amg"))
       .key("preconditionerRefresh", Schema::integer("outer iterations between AMG value refreshes").atLeast(1),
            Default(d.pressurePreconditionerRefresh));
   Schema solvers = Schema::map("linear solvers")
@@ -250,6 +252,7 @@ FluidOptions readFluidOptions(const SceneConfig& c, const HexMesh& mesh) {
   };
   o.pressureSolver = solver("solvers.pressure");
   o.momentumSolver = solver("solvers.momentum");
+  o.pressureFinalRelTol = c.get<double>("solvers.pressure.finalRelTol");
   o.pressurePreconditioner = c.get<std::string>("solvers.pressure.preconditioner") == "jacobi"
                                  ? PressurePreconditioner::Jacobi
                                  : PressurePreconditioner::Amg;

@@ -163,11 +163,14 @@ struct FluidOptions {
   PimpleOptions pimple;
   LinearSolverOptions momentumSolver{1e-10, 0.0, 1000};
   LinearSolverOptions pressureSolver{1e-10, 0.0, 5000};
+  /// relTol of the final pressure solve of a step (last corrector of the last outer iteration,
+  /// OpenFOAM's pFinal); negative: the same as pressureSolver.relTol.
+  real pressureFinalRelTol = -1.0;
   PressurePreconditioner pressurePreconditioner = PressurePreconditioner::Amg;
-  /// Outer iterations between value refreshes of the pressure preconditioner (it is always
-  /// refreshed at the start of `solve()`). A slightly stale AMG hierarchy is still a good, fixed
-  /// SPD preconditioner, and its refresh costs more than a solve on small meshes. Jacobi is
-  /// refreshed every outer iteration regardless.
+  /// Outer iterations between value refreshes of the pressure preconditioner, counted across time
+  /// steps (the first solve always sets it up). A slightly stale AMG hierarchy is still a good,
+  /// fixed SPD preconditioner, and its refresh costs about as much as a solve. Jacobi is refreshed
+  /// every outer iteration regardless.
   int pressurePreconditionerRefresh = 10;
   /// Used only when no boundary fixes the pressure level.
   lid_t pressureReferenceCell = 0;

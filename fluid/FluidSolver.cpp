@@ -744,8 +744,13 @@ StepResult FluidSolver::solve() {
         const int refresh = opt_.pressurePreconditioner == PressurePreconditioner::Jacobi
                                 ? 1
                                 : std::max(1, opt_.pressurePreconditionerRefresh);
-        if (corr == 0 && no == 0 && outer % refresh == 0) linear_.pressureMatrixChanged(exec_, Ap_);
-        const auto st = linear_.solvePressure(exec_, Ap_, rhsP_, p_, opt_.pressureSolver);
+        if (corr == 0 && no == 0 && pressureAssemblies_++ % refresh == 0) linear_.pressureMatrixChanged(exec_, Ap_);
+        // The last solve of the step may be tighter than the intermediate ones (pFinal).
+        LinearSolverOptions ps = opt_.pressureSolver;
+        const bool finalSolve =
+            outer == pim.nOuterCorrectors - 1 && corr == pim.nCorrectors - 1 && no == pim.nNonOrthogonalCorrectors;
+        if (finalSolve && opt_.pressureFinalRelTol >= 0) ps.relTol = opt_.pressureFinalRelTol;
+        const auto st = linear_.solvePressure(exec_, Ap_, rhsP_, p_, ps);
         if (pRes < 0) pRes = st.initialResidual;
         res.pressureIterations += st.iterations;
         if (st.breakdown) res.ok = false;

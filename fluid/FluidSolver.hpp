@@ -165,6 +165,9 @@ class FluidSolver {
 
   real t_ = 0, dt_ = 1, dt0_ = 1;
   int nSteps_ = 0;
+  /// Pressure-matrix assemblies since the preconditioner values were last refreshed, counted
+  /// across steps so a one-outer-iteration PISO run does not rebuild the AMG every step.
+  long pressureAssemblies_ = 0;
   bool bdf2Active_ = false;
   real c1_ = 0, c0_ = 0, c00_ = 0;  ///< time weights: d(phi)/dt ~ (c1 phi - c0 phi0 + c00 phi00)/dt
   MeshMotion motion_;
