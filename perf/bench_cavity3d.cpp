@@ -29,7 +29,9 @@
 #include "core/Error.hpp"
 #include "fluid/FluidSolver.hpp"
 
+#include <algorithm>
 #include <chrono>
+#include <cstdio>
 #include <cstdlib>
 #include <map>
 #include <string>
@@ -74,6 +76,54 @@ struct RegionTimes {
   static void stop() {
     Kokkos::Tools::Experimental::set_push_region_callback(nullptr);
     Kokkos::Tools::Experimental::set_pop_region_callback(nullptr);
+  }
+  /// Per-kernel times (profile mode 2). On host backends a kernel launch is synchronous, so the
+  /// begin/end callbacks bracket its execution.
+  static std::map<std::string, std::pair<double, long>>& kernels() {
+    static std::map<std::string, std::pair<double, long>> k;
+    return k;
+  }
+  static std::vector<std::pair<std::string, Clock::time_point>>& open() {
+    static std::vector<std::pair<std::string, Clock::time_point>> o;
+    return o;
+  }
+  static void beginKernel(const char* name, uint32_t, uint64_t* id) {
+    *id = open().size();
+    open().emplace_back(name, Clock::now());
+  }
+  static void endKernel(uint64_t id) {
+    auto& e = kernels()[open()[id].first];
+    e.first += std::chrono::duration<double>(Clock::now() - open()[id].second).count();
+    ++e.second;
+    open().resize(id);
+  }
+  static void startKernels() {
+    kernels().clear();
+    open().clear();
+    Kokkos::Tools::Experimental::set_begin_parallel_for_callback(&beginKernel);
+    Kokkos::Tools::Experimental::set_end_parallel_for_callback(&endKernel);
+    Kokkos::Tools::Experimental::set_begin_parallel_reduce_callback(&beginKernel);
+    Kokkos::Tools::Experimental::set_end_parallel_reduce_callback(&endKernel);
+    Kokkos::Tools::Experimental::set_begin_parallel_scan_callback(&beginKernel);
+    Kokkos::Tools::Experimental::set_end_parallel_scan_callback(&endKernel);
+  }
+  static void stopKernels(double total, int steps) {
+    Kokkos::Tools::Experimental::set_begin_parallel_for_callback(nullptr);
+    Kokkos::Tools::Experimental::set_end_parallel_for_callback(nullptr);
+    Kokkos::Tools::Experimental::set_begin_parallel_reduce_callback(nullptr);
+    Kokkos::Tools::Experimental::set_end_parallel_reduce_callback(nullptr);
+    Kokkos::Tools::Experimental::set_begin_parallel_scan_callback(nullptr);
+    Kokkos::Tools::Experimental::set_end_parallel_scan_callback(nullptr);
+    std::vector<std::pair<double, std::string>> rows;
+    double sum = 0;
+    for (const auto& [name, e] : kernels()) {
+      rows.emplace_back(e.first, name + " (" + std::to_string(e.second / steps) + "/step)");
+      sum += e.first;
+    }
+    std::sort(rows.rbegin(), rows.rend());
+    std::fprintf(stderr, "kernels: %.1f%% of the timed wall time; per step:\n", 100.0 * sum / total);
+    for (const auto& [t, name] : rows)
+      if (t > 0.002 * total) std::fprintf(stderr, "  %8.2f ms  %5.1f%%  %s\n", 1e3 * t / steps, 100.0 * t / total, name.c_str());
   }
   static double get(const std::string& name) {
     auto it = total().find(name);
@@ -124,6 +174,7 @@ void BM_Cavity3d(benchmark::State& state) {
     FluidSolver fluid(mesh, o);
     for (int s = 0; s < kUntimedSteps; ++s) ok = fluid.solveStep(s * dt, dt).ok && ok;
     if (profile) RegionTimes::start();
+    if (state.range(1) == 2) RegionTimes::startKernels();
     Kokkos::fence();
     const auto t0 = Clock::now();
     int pi = 0, ui = 0;
@@ -137,6 +188,7 @@ void BM_Cavity3d(benchmark::State& state) {
     Kokkos::fence();
     const double t = std::chrono::duration<double>(Clock::now() - t0).count();
     if (profile) RegionTimes::stop();
+    if (state.range(1) == 2) RegionTimes::stopKernels(t, timed);
     state.SetIterationTime(t);
     seconds += t;
     pIters += pi;
@@ -184,6 +236,7 @@ const int kN = mfsi::bench::tiny() ? 4 : envInt("MFSI_CAVITY3D_N", 64);
 BENCHMARK(BM_Cavity3d)
     ->Args({kN, 0})
     ->Args({kN, 1})
+    ->Args({kN, 2})
     ->ArgNames({"N", "profile"})
     ->Iterations(1)
     ->UseManualTime()
