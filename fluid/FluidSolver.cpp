@@ -54,6 +54,8 @@ FluidSolver::FluidSolver(const HexMesh& mesh, const FluidOptions& options)
   fcU_ = allocateFaceCoefficients(mesh, "mfsi::fluid::momentum::face");
   fcP_ = allocateFaceCoefficients(mesh, "mfsi::fluid::pressure::face");
   bc_ = BoundaryConditions(mesh, opt_);
+  boundaryCells_ = boundaryCells(mesh);
+  for (const auto& rp : bc_.patches()) hasResistance_ = hasResistance_ || rp.type == BoundaryType::Resistance;
   linear_ = LinearSolver(nCells_, opt_.pressurePreconditioner);
 
   U_ = Real3View("mfsi::fluid::U", nCells_);
@@ -121,6 +123,20 @@ FluidSolver::FluidSolver(const HexMesh& mesh, const FluidOptions& options)
 void FluidSolver::updateGeometry() {
   computeGeometry(exec_, mesh_, geo_);
   computeFaceData(exec_, mesh_, geo_, fd_);
+  gradPValid_ = false;
+  // Largest |k_f| / |S_f| of the non-orthogonal part of the internal face area vectors.
+  ConstReal3View k = fd_.nonOrth;
+  ConstRealView sm = geo_.faceAreaMag;
+  real kmax = 0;
+  Kokkos::parallel_reduce(
+      "mfsi::fluid::faceData::nonOrthMax", RangePolicy(exec_, 0, nIn_),
+      KOKKOS_LAMBDA(lid_t f, real & m) {
+        const real r = (kmath::fabs(k(f, 0)) + kmath::fabs(k(f, 1)) + kmath::fabs(k(f, 2))) / sm(f);
+        m = r > m ? r : m;
+      },
+      Kokkos::Max<real>(kmax));
+  // Round-off of a Cartesian mesh is ~1e-16; a face tilted by 1e-8 rad already counts.
+  nonOrthogonal_ = !(kmax <= 1e-12);
 }
 
 void FluidSolver::computeTimeCoefficients() {
@@ -181,6 +197,8 @@ void FluidSolver::beginStep(real t, real dt) {
   computeTimeCoefficients();
   computeMeshFlux();
   bc_.update(exec_, t_ + dt_, geo_, faceMeshVel_);
+  // New prescribed pressures (time functions) change the boundary values the gradient sees.
+  if (bc_.fixesPressureLevel()) gradPValid_ = false;
   updateBoundaryVelocity();
 }
 
@@ -235,6 +253,7 @@ void FluidSolver::setVelocity(const ConstReal3View& u) {
 
 void FluidSolver::setPressure(const ConstRealView& p) {
   if (p.data() != p_.data()) Kokkos::deep_copy(exec_, p_, p);
+  gradPValid_ = false;
   updatePressureGradient();
 }
 
@@ -321,20 +340,23 @@ void FluidSolver::updateBoundaryPressure() {
 }
 
 void FluidSolver::updatePressureGradient() {
+  if (gradPValid_) return;
   // The extrapolated wall values depend on the gradient they feed; two passes contract the lag by
-  // a factor of four (each pass halves it) and the outer iterations converge it.
-  for (int pass = 0; pass < 2; ++pass) {
+  // a factor of four (each pass halves it) and the outer iterations converge it. Boundary values
+  // that do not depend on the gradient need one pass.
+  // Only the cells next to the boundary see the boundary values, so the second pass updates
+  // those alone.
+  updateBoundaryPressure();
+  cellGradient(exec_, opt_.gradient, mesh_, geo_, fd_, p_, pb_, gradP_);
+  if (opt_.wallPressure == WallPressure::Extrapolated) {
     updateBoundaryPressure();
-    computePressureGradient();
+    cellGradient(exec_, opt_.gradient, mesh_, geo_, fd_, p_, pb_, gradP_, boundaryCells_);
   }
+  gradPValid_ = true;
 }
 
 void FluidSolver::computeVelocityGradient() {
   cellGradient(exec_, opt_.gradient, mesh_, geo_, fd_, U_, Ub_, gradU_);
-}
-
-void FluidSolver::computePressureGradient() {
-  cellGradient(exec_, opt_.gradient, mesh_, geo_, fd_, p_, pb_, gradP_);
 }
 
 // ------------------------------------------------------------------------------------------------
@@ -348,6 +370,7 @@ void FluidSolver::assembleMomentum() {
   const bool implicitLinear = scheme == ConvectionScheme::Linear;
   const bool limited = scheme == ConvectionScheme::LimitedLinear || scheme == ConvectionScheme::VanLeer;
   const lid_t nIn = nIn_;
+  const bool nonOrth = nonOrthogonal_;
   ConstIndexView own = mesh_.faceOwner(), nei = mesh_.faceNeighbour();
   ConstIndexView kind = bc_.kind();
   ConstRealView phi = phi_, mp = meshPhi_, w = fd_.weight, dc = fd_.deltaCoeff;
@@ -376,9 +399,12 @@ void FluidSolver::assembleMomentum() {
           const lid_t C = F >= 0 ? o : n, Dn = F >= 0 ? n : o;
           for (int j = 0; j < 3; ++j) {
             // Explicit non-orthogonal part of the diffusive flux.
-            real corr = 0;
-            for (int i = 0; i < 3; ++i) corr += kv(f, i) * (wf * G(o, i, j) + (1.0 - wf) * G(n, i, j));
-            real fl = -mu * corr;
+            real fl = 0;
+            if (nonOrth) {
+              real corr = 0;
+              for (int i = 0; i < 3; ++i) corr += kv(f, i) * (wf * G(o, i, j) + (1.0 - wf) * G(n, i, j));
+              fl = -mu * corr;
+            }
             if (limited) {
               // Deferred correction: implicit upwind plus F (phi_TVD - phi_upwind) lagged.
               const real phiC = U(C, j), phiD = U(Dn, j);
@@ -518,42 +544,30 @@ void FluidSolver::computePhiHbyA() {
       });
 }
 
-void FluidSolver::assemblePressure() {
+void FluidSolver::assemblePressureMatrix() {
   ScopedRegion region("mfsi::fluid::pressure::assemble");
+  // The matrix depends on rAU and the geometry only: the same for every pressure corrector of one
+  // outer iteration, so it is assembled once per outer iteration (the source every corrector).
   const lid_t nIn = nIn_;
   ConstIndexView own = mesh_.faceOwner(), nei = mesh_.faceNeighbour();
   ConstIndexView kind = bc_.kind();
-  ConstRealView w = fd_.weight, dc = fd_.deltaCoeff, rAU = rAU_, phiH = phiHbyA_, pb = pb_;
-  ConstReal3View kv = fd_.nonOrth, gp = gradP_;
+  ConstRealView w = fd_.weight, dc = fd_.deltaCoeff, rAU = rAU_;
   auto od = fcP_.ownerDiag, nd = fcP_.neighbourDiag, up = fcP_.upper, lo = fcP_.lower;
-  auto flux = fluxP_;
   Kokkos::parallel_for(
       "mfsi::fluid::pressure::faceCoefficients", RangePolicy(exec_, 0, nFaces_), KOKKOS_LAMBDA(lid_t f) {
         const lid_t o = own(f);
         if (f < nIn) {
           const lid_t n = nei(f);
           const real wf = w(f);
-          const real rAUf = wf * rAU(o) + (1.0 - wf) * rAU(n);
-          const real coef = rAUf * dc(f);
+          const real coef = (wf * rAU(o) + (1.0 - wf) * rAU(n)) * dc(f);
           od(f) = nd(f) = coef;
           up(f) = lo(f) = -coef;
-          real corr = 0;
-          for (int i = 0; i < 3; ++i) corr += kv(f, i) * (wf * gp(o, i) + (1.0 - wf) * gp(n, i));
-          flux(f) = phiH(f) - rAUf * corr;
         } else {
           up(f) = lo(f) = nd(f) = 0.0;
-          if (kind(f - nIn) == kFacePressure) {
-            const real coef = rAU(o) * dc(f);
-            od(f) = coef;
-            flux(f) = phiH(f) - coef * pb(f - nIn);
-          } else {
-            od(f) = 0.0;
-            flux(f) = phiH(f);
-          }
+          od(f) = kind(f - nIn) == kFacePressure ? rAU(o) * dc(f) : 0.0;
         }
       });
-  const bool ac = compressible();
-  if (ac) {
+  if (compressible()) {
     // Artificial compressibility: the linearised mass balance of a fluid with density
     // rho + p / c^2 in a moving cell, d(V p)/dt / (rho c^2) + sum_f phi_f = 0 (the rho part cancels
     // against the mesh fluxes by space conservation). The time derivative uses the momentum
@@ -570,8 +584,49 @@ void FluidSolver::assemblePressure() {
     Kokkos::deep_copy(exec_, cellDiag_, 0.0);
   }
   assembleMatrix(exec_, mesh_, sparsity_, fcP_, cellDiag_, Ap_, opt_.reduction);
+  if (pinsPressureLevel()) {
+    // No boundary sets the level: doubling one diagonal entry (and adding the matching source in
+    // assemblePressureSource) pins p at the reference cell without changing the other equations.
+    const lid_t ref = opt_.pressureReferenceCell;
+    ConstIndexView di = Ap_.diagIdx;
+    auto vals = Ap_.values;
+    Kokkos::parallel_for(
+        "mfsi::fluid::pressure::reference", RangePolicy(exec_, 0, 1),
+        KOKKOS_LAMBDA(lid_t) { vals(di(ref)) *= 2.0; });
+  }
+}
+
+void FluidSolver::assemblePressureSource() {
+  ScopedRegion region("mfsi::fluid::pressure::assemble");
+  const lid_t nIn = nIn_;
+  ConstIndexView own = mesh_.faceOwner(), nei = mesh_.faceNeighbour();
+  ConstIndexView kind = bc_.kind();
+  ConstRealView w = fd_.weight, dc = fd_.deltaCoeff, rAU = rAU_, phiH = phiHbyA_, pb = pb_;
+  ConstReal3View kv = fd_.nonOrth, gp = gradP_;
+  const bool nonOrth = nonOrthogonal_;
+  auto flux = fluxP_;
+  Kokkos::parallel_for(
+      "mfsi::fluid::pressure::sourceFlux", RangePolicy(exec_, 0, nFaces_), KOKKOS_LAMBDA(lid_t f) {
+        const lid_t o = own(f);
+        if (f < nIn) {
+          real fl = phiH(f);
+          if (nonOrth) {
+            const lid_t n = nei(f);
+            const real wf = w(f);
+            const real rAUf = wf * rAU(o) + (1.0 - wf) * rAU(n);
+            real corr = 0;
+            for (int i = 0; i < 3; ++i) corr += kv(f, i) * (wf * gp(o, i) + (1.0 - wf) * gp(n, i));
+            fl -= rAUf * corr;
+          }
+          flux(f) = fl;
+        } else if (kind(f - nIn) == kFacePressure) {
+          flux(f) = phiH(f) - rAU(o) * dc(f) * pb(f - nIn);
+        } else {
+          flux(f) = phiH(f);
+        }
+      });
   divergence<1>(exec_, mesh_, fluxP_, rhsP_, opt_.reduction, /*accumulate=*/false, /*sign=*/-1.0);
-  if (ac) {
+  if (compressible()) {
     const real c = opt_.artificialCompressibility.soundSpeed;
     const real k = 1.0 / (opt_.density * c * c * dt_), c0 = c0_, c00 = c00_;
     ConstRealView V0 = V0_, V00 = V00_, p0 = p0_, p00 = p00_;
@@ -580,22 +635,22 @@ void FluidSolver::assemblePressure() {
         "mfsi::fluid::pressure::compressibilitySource", RangePolicy(exec_, 0, nCells_),
         KOKKOS_LAMBDA(lid_t c) { rhs(c) += k * (c0 * V0(c) * p0(c) - c00 * V00(c) * p00(c)); });
   }
-  // With artificial compressibility the matrix is regular and the level is physical: no pinning.
-  if (!bc_.fixesPressureLevel() && !ac) {
-    // No boundary sets the level: doubling one diagonal entry (and adding the matching source)
-    // pins p at the reference cell without changing the other equations.
+  if (pinsPressureLevel()) {
+    // The reference row's diagonal was doubled from a: its source gets a pRef (a = half of it).
     const lid_t ref = opt_.pressureReferenceCell;
     const real pRef = opt_.pressureReferenceValue;
     ConstIndexView di = Ap_.diagIdx;
-    auto vals = Ap_.values;
+    ConstRealView vals = Ap_.values;
     auto rhs = rhsP_;
     Kokkos::parallel_for(
-        "mfsi::fluid::pressure::reference", RangePolicy(exec_, 0, 1), KOKKOS_LAMBDA(lid_t) {
-          const real a = vals(di(ref));
-          vals(di(ref)) = 2.0 * a;
-          rhs(ref) += a * pRef;
-        });
+        "mfsi::fluid::pressure::referenceSource", RangePolicy(exec_, 0, 1),
+        KOKKOS_LAMBDA(lid_t) { rhs(ref) += 0.5 * vals(di(ref)) * pRef; });
   }
+}
+
+bool FluidSolver::pinsPressureLevel() const {
+  // With artificial compressibility the matrix is regular and the level is physical: no pinning.
+  return !bc_.fixesPressureLevel() && !compressible();
 }
 
 void FluidSolver::correctFluxAndVelocity() {
@@ -620,6 +675,7 @@ void FluidSolver::correctFluxAndVelocity() {
           }
         });
   }
+  gradPValid_ = false;  // p is the one just solved for
   const real ap = opt_.pimple.relaxPressure;
   if (ap < 1.0) {
     auto p = p_;
@@ -704,7 +760,11 @@ StepResult FluidSolver::solve() {
   ConstRealView V = geo_.cellVolume;
   for (int outer = 0; outer < pim.nOuterCorrectors; ++outer) {
     updateBoundaryVelocity();
-    computeVelocityGradient();
+    // The velocity gradient feeds only the non-orthogonal diffusion correction and the limited
+    // convection schemes; both vanish on a Cartesian mesh with linear convection.
+    const bool limited =
+        opt_.convection == ConvectionScheme::LimitedLinear || opt_.convection == ConvectionScheme::VanLeer;
+    if (nonOrthogonal_ || limited) computeVelocityGradient();
     assembleMomentum();
     updatePressureGradient();
     real momRes = 0;
@@ -735,10 +795,12 @@ StepResult FluidSolver::solve() {
       computeHbyA();
       computePhiHbyA();
       bc_.updateResistance(exec_, phi_);
+      if (hasResistance_) gradPValid_ = false;
       Kokkos::deep_copy(exec_, pPrev_, p_);
       for (int no = 0; no <= pim.nNonOrthogonalCorrectors; ++no) {
         updatePressureGradient();
-        assemblePressure();
+        if (corr == 0 && no == 0) assemblePressureMatrix();
+        assemblePressureSource();
         ScopedRegion r3("mfsi::fluid::pressure::solve");
         // rAU, hence the matrix, is the same for every corrector of one outer iteration.
         const int refresh = opt_.pressurePreconditioner == PressurePreconditioner::Jacobi
@@ -751,6 +813,7 @@ StepResult FluidSolver::solve() {
             outer == pim.nOuterCorrectors - 1 && corr == pim.nCorrectors - 1 && no == pim.nNonOrthogonalCorrectors;
         if (finalSolve && opt_.pressureFinalRelTol >= 0) ps.relTol = opt_.pressureFinalRelTol;
         const auto st = linear_.solvePressure(exec_, Ap_, rhsP_, p_, ps);
+        gradPValid_ = false;
         if (pRes < 0) pRes = st.initialResidual;
         res.pressureIterations += st.iterations;
         if (st.breakdown) res.ok = false;

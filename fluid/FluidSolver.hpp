@@ -122,12 +122,13 @@ class FluidSolver {
   void updateBoundaryVelocity();
   void updateBoundaryPressure();
   void computeVelocityGradient();
-  void computePressureGradient();
   void updatePressureGradient();
   void assembleMomentum();
   void computeHbyA();
   void computePhiHbyA();
-  void assemblePressure();
+  void assemblePressureMatrix();
+  void assemblePressureSource();
+  bool pinsPressureLevel() const;
   void correctFluxAndVelocity();
   bool compressible() const;
   void storeDdtCorrection();
@@ -160,6 +161,7 @@ class FluidSolver {
   // Boundary-face fields.
   Real3View Ub_, faceMeshVel_;
   RealView pb_;
+  IndexView boundaryCells_;  ///< cells owning a boundary face
   // Mesh positions at the start of the step.
   Real3View points0_;
 
@@ -169,6 +171,13 @@ class FluidSolver {
   /// across steps so a one-outer-iteration PISO run does not rebuild the AMG every step.
   long pressureAssemblies_ = 0;
   bool bdf2Active_ = false;
+  /// gradP_ (and pb_) match the current p_, boundary pressures and geometry: the gradient is the
+  /// same in every place that asks for it until one of those changes (see invalidations).
+  bool gradPValid_ = false;
+  /// Some internal face is non-orthogonal (S not parallel to d): the explicit corrections, and the
+  /// velocity gradient they need, are live. False on Cartesian meshes, where they vanish exactly.
+  bool nonOrthogonal_ = true;
+  bool hasResistance_ = false;  ///< a resistance outlet changes the boundary pressure every corrector
   real c1_ = 0, c0_ = 0, c00_ = 0;  ///< time weights: d(phi)/dt ~ (c1 phi - c0 phi0 + c00 phi00)/dt
   MeshMotion motion_;
 };
