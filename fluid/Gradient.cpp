@@ -1,5 +1,8 @@
 #include "fluid/Gradient.hpp"
 
+#include <algorithm>
+#include <vector>
+
 namespace mfsi::fluid {
 
 namespace {
@@ -31,8 +34,10 @@ KOKKOS_INLINE_FUNCTION void solve3(const real M[3][3], const real b[3], real x[3
 
 template <int NC, class F, class FB, class G>
 void gradientImpl(const ExecSpace& exec, GradientScheme scheme, const HexMesh& mesh, const MeshGeometry& geo,
-                  const FvFaceData& fd, const F& phi, const FB& phiB, const G& grad) {
+                  const FvFaceData& fd, const F& phi, const FB& phiB, const G& grad, const ConstIndexView& cells) {
   using detail::comp;
+  const bool listed = cells.extent(0) > 0;
+  const lid_t count = listed ? static_cast<lid_t>(cells.extent(0)) : mesh.nCells();
   ConstIndexView off = mesh.cellFaceOffsets();
   ConstIndexView cf = mesh.cellFaces();
   ConstIndexView own = mesh.faceOwner();
@@ -45,7 +50,8 @@ void gradientImpl(const ExecSpace& exec, GradientScheme scheme, const HexMesh& m
   const lid_t nIn = mesh.nInternalFaces();
   if (scheme == GradientScheme::GaussLinear) {
     Kokkos::parallel_for(
-        "mfsi::fluid::gradient::gauss", RangePolicy(exec, 0, mesh.nCells()), KOKKOS_LAMBDA(lid_t c) {
+        "mfsi::fluid::gradient::gauss", RangePolicy(exec, 0, count), KOKKOS_LAMBDA(lid_t i) {
+          const lid_t c = listed ? cells(i) : i;
           real g[3][NC];
           for (int i = 0; i < 3; ++i)
             for (int k = 0; k < NC; ++k) g[i][k] = 0;
@@ -67,7 +73,8 @@ void gradientImpl(const ExecSpace& exec, GradientScheme scheme, const HexMesh& m
         });
   } else {
     Kokkos::parallel_for(
-        "mfsi::fluid::gradient::leastSquares", RangePolicy(exec, 0, mesh.nCells()), KOKKOS_LAMBDA(lid_t c) {
+        "mfsi::fluid::gradient::leastSquares", RangePolicy(exec, 0, count), KOKKOS_LAMBDA(lid_t ic) {
+          const lid_t c = listed ? cells(ic) : ic;
           real M[3][3] = {{0, 0, 0}, {0, 0, 0}, {0, 0, 0}};
           real b[NC][3];
           for (int k = 0; k < NC; ++k) b[k][0] = b[k][1] = b[k][2] = 0;
@@ -96,13 +103,28 @@ void gradientImpl(const ExecSpace& exec, GradientScheme scheme, const HexMesh& m
 }  // namespace
 
 void cellGradient(const ExecSpace& exec, GradientScheme scheme, const HexMesh& mesh, const MeshGeometry& geo,
-                  const FvFaceData& fd, const ConstRealView& phi, const ConstRealView& phiB, const Real3View& grad) {
-  gradientImpl<1>(exec, scheme, mesh, geo, fd, phi, phiB, grad);
+                  const FvFaceData& fd, const ConstRealView& phi, const ConstRealView& phiB, const Real3View& grad,
+                  const ConstIndexView& cells) {
+  gradientImpl<1>(exec, scheme, mesh, geo, fd, phi, phiB, grad, cells);
 }
 
 void cellGradient(const ExecSpace& exec, GradientScheme scheme, const HexMesh& mesh, const MeshGeometry& geo,
-                  const FvFaceData& fd, const ConstReal3View& u, const ConstReal3View& uB, const Tensor3View& grad) {
-  gradientImpl<3>(exec, scheme, mesh, geo, fd, u, uB, grad);
+                  const FvFaceData& fd, const ConstReal3View& u, const ConstReal3View& uB, const Tensor3View& grad,
+                  const ConstIndexView& cells) {
+  gradientImpl<3>(exec, scheme, mesh, geo, fd, u, uB, grad, cells);
+}
+
+IndexView boundaryCells(const HexMesh& mesh) {
+  auto own = Kokkos::create_mirror_view_and_copy(HostSpace(), mesh.faceOwner());
+  std::vector<lid_t> cells;
+  for (lid_t f = mesh.nInternalFaces(); f < mesh.nFaces(); ++f) cells.push_back(own(f));
+  std::sort(cells.begin(), cells.end());
+  cells.erase(std::unique(cells.begin(), cells.end()), cells.end());
+  IndexView out(Kokkos::view_alloc(Kokkos::WithoutInitializing, "mfsi::fluid::boundaryCells"), cells.size());
+  auto h = Kokkos::create_mirror_view(out);
+  for (std::size_t i = 0; i < cells.size(); ++i) h(i) = cells[i];
+  Kokkos::deep_copy(out, h);
+  return out;
 }
 
 }  // namespace mfsi::fluid
