@@ -160,6 +160,11 @@ struct FluidOptions {
   GradientScheme gradient = GradientScheme::GaussLinear;
   WallPressure wallPressure = WallPressure::Extrapolated;
   ReductionMode reduction = ReductionMode::Gather;
+  /// Assemble the momentum matrix and source in one pass over each cell's faces when nothing needs
+  /// per-face explicit fluxes (orthogonal mesh, linear or upwind convection, Gather reduction).
+  /// Gives the same matrix and source bitwise as the face-coefficient path; false forces that
+  /// path (verification, perf comparison). Not a scene key.
+  bool fusedMomentumAssembly = true;
   PimpleOptions pimple;
   LinearSolverOptions momentumSolver{1e-10, 0.0, 1000};
   LinearSolverOptions pressureSolver{1e-10, 0.0, 5000};

@@ -223,6 +223,7 @@ void FluidSolver::setWallVelocity(const std::string& name, const ConstReal3View&
 
 void FluidSolver::setVelocity(const ConstReal3View& u) {
   if (u.data() != U_.data()) Kokkos::deep_copy(exec_, U_, u);
+  gradUCurrent_ = false;
   updateBoundaryVelocity();
   // Fluxes consistent with the new field: interpolated on internal faces, u_b . S on the boundary.
   ConstIndexView own = mesh_.faceOwner(), nei = mesh_.faceNeighbour();
@@ -359,6 +360,14 @@ void FluidSolver::computeVelocityGradient() {
   cellGradient(exec_, opt_.gradient, mesh_, geo_, fd_, U_, Ub_, gradU_);
 }
 
+ConstTensor3View FluidSolver::velocityGradient() const {
+  if (!gradUCurrent_) {
+    cellGradient(exec_, opt_.gradient, mesh_, geo_, fd_, U_, Ub_, gradU_);
+    gradUCurrent_ = true;
+  }
+  return gradU_;
+}
+
 // ------------------------------------------------------------------------------------------------
 // Momentum
 // ------------------------------------------------------------------------------------------------
@@ -369,6 +378,8 @@ void FluidSolver::assembleMomentum() {
   const ConvectionScheme scheme = opt_.convection;
   const bool implicitLinear = scheme == ConvectionScheme::Linear;
   const bool limited = scheme == ConvectionScheme::LimitedLinear || scheme == ConvectionScheme::VanLeer;
+  if (opt_.fusedMomentumAssembly && !limited && !nonOrthogonal_ && opt_.reduction == ReductionMode::Gather)
+    return assembleMomentumFused();
   const lid_t nIn = nIn_;
   const bool nonOrth = nonOrthogonal_;
   ConstIndexView own = mesh_.faceOwner(), nei = mesh_.faceNeighbour();
@@ -481,6 +492,90 @@ void FluidSolver::assembleMomentum() {
         vals(di(c)) = ar;
         diag(c) = ar;
         for (int j = 0; j < 3; ++j) rhs(c, j) += (ar - a) * U(c, j);
+      });
+}
+
+void FluidSolver::assembleMomentumFused() {
+  // One thread per cell assembles its row, its source and the relaxation in one pass over its
+  // faces: no per-face coefficient arrays, no separate gather, divergence, cell and relaxation
+  // kernels (~2.5x less memory traffic). Only valid where internal faces carry no explicit flux
+  // (no non-orthogonal correction, no deferred-correction convection). Every sum runs in the order
+  // of the face-coefficient path (cell term first, then the cell's faces in cellFaces() order), so
+  // both give the same bits.
+  const real rho = opt_.density, mu = opt_.viscosity;
+  const bool implicitLinear = opt_.convection == ConvectionScheme::Linear;
+  const bool steady = opt_.timeScheme == TimeScheme::Steady;
+  const real rdt = 1.0 / dt_, c1 = c1_, c0 = c0_, c00 = c00_;
+  const real gx = opt_.bodyForce[0], gy = opt_.bodyForce[1], gz = opt_.bodyForce[2];
+  const real alpha = opt_.pimple.relaxVelocity;
+  const lid_t nIn = nIn_;
+  ConstIndexView off = mesh_.cellFaceOffsets(), cf = mesh_.cellFaces(), own = mesh_.faceOwner();
+  ConstIndexView cfp = sparsity_.cellFacePos, rowPtr = Au_.rowPtr, di = Au_.diagIdx;
+  ConstIndexView kind = bc_.kind();
+  ConstRealView phi = phi_, mp = meshPhi_, w = fd_.weight, dc = fd_.deltaCoeff;
+  ConstRealView V = geo_.cellVolume, V0 = V0_, V00 = V00_;
+  ConstReal3View U = U_, U0 = U0_, U00 = U00_, Ub = Ub_;
+  auto vals = Au_.values;
+  auto diagU = diagU_;
+  auto rhs = rhsU_;
+  Kokkos::parallel_for(
+      "mfsi::fluid::momentum::assembleFused", RangePolicy(exec_, 0, nCells_), KOKKOS_LAMBDA(lid_t c) {
+        for (lid_t k = rowPtr(c); k < rowPtr(c + 1); ++k) vals(k) = 0.0;
+        real diag = steady ? 0.0 : rho * c1 * V(c) * rdt;
+        const real g[3] = {gx, gy, gz};
+        real src[3], bsum[3] = {0.0, 0.0, 0.0};
+        for (int j = 0; j < 3; ++j) {
+          src[j] = rho * V(c) * g[j];
+          if (!steady) src[j] += rho * (c0 * V0(c) * U0(c, j) - c00 * V00(c) * U00(c, j)) * rdt;
+        }
+        for (lid_t e = off(c); e < off(c + 1); ++e) {
+          const lid_t f = cf(e);
+          const real F = rho * (phi(f) - mp(f));  // mass flux relative to the moving face
+          const real D = mu * dc(f);
+          if (f < nIn) {
+            const bool isOwner = own(f) == c;
+            const real wf = w(f);
+            real dg, od;
+            if (implicitLinear) {
+              dg = isOwner ? F * wf + D : -F * (1.0 - wf) + D;
+              od = isOwner ? F * (1.0 - wf) - D : -F * wf - D;
+            } else {
+              const real Fp = F > 0 ? F : 0.0, Fm = F < 0 ? F : 0.0;
+              dg = isOwner ? Fp + D : -Fm + D;
+              od = isOwner ? Fm - D : -Fp - D;
+            }
+            diag += dg;
+            vals(cfp(e)) += od;
+          } else {
+            // A boundary face's owner is this cell: its flux enters the divergence with +1.
+            const lid_t b = f - nIn;
+            switch (kind(b)) {
+              case kFaceVelocity:
+              case kFaceWall:
+                diag += D;
+                for (int j = 0; j < 3; ++j) bsum[j] += (F - D) * Ub(b, j);
+                break;
+              case kFaceSlip:
+                diag += D;
+                for (int j = 0; j < 3; ++j) bsum[j] += -D * Ub(b, j);
+                break;
+              case kFaceEmpty:
+                diag += 0.0;
+                break;
+              default: {  // pressure outlet: zero-gradient, outflow implicit, backflow lagged
+                diag += F > 0 ? F : 0.0;
+                const real Fm = F < 0 ? F : 0.0;
+                for (int j = 0; j < 3; ++j) bsum[j] += Fm * Ub(b, j);
+                break;
+              }
+            }
+          }
+        }
+        // Implicit under-relaxation: a_P -> a_P / alpha, source += (a_P / alpha - a_P) u_prev.
+        const real ar = diag / alpha;
+        vals(di(c)) = ar;
+        diagU(c) = ar;
+        for (int j = 0; j < 3; ++j) rhs(c, j) = (src[j] + -1.0 * bsum[j]) + (ar - diag) * U(c, j);
       });
 }
 
@@ -764,7 +859,8 @@ StepResult FluidSolver::solve() {
     // convection schemes; both vanish on a Cartesian mesh with linear convection.
     const bool limited =
         opt_.convection == ConvectionScheme::LimitedLinear || opt_.convection == ConvectionScheme::VanLeer;
-    if (nonOrthogonal_ || limited) computeVelocityGradient();
+    gradUCurrent_ = nonOrthogonal_ || limited;
+    if (gradUCurrent_) computeVelocityGradient();
     assembleMomentum();
     updatePressureGradient();
     real momRes = 0;

@@ -107,8 +107,10 @@ class FluidSolver {
   ConstReal3View boundaryVelocity() const { return Ub_; }
   /// Pressure on boundary faces (index f - nInternalFaces).
   ConstRealView boundaryPressure() const { return pb_; }
-  /// Velocity gradient of the last outer iteration, G(c, i, j) = du_j/dx_i.
-  ConstTensor3View velocityGradient() const { return gradU_; }
+  /// Velocity gradient G(c, i, j) = du_j/dx_i: the one the last outer iteration used, or, where the
+  /// discretisation did not need it (orthogonal mesh, linear/upwind convection), computed from the
+  /// current velocity on first request.
+  ConstTensor3View velocityGradient() const;
   /// Start time of the current step and its size.
   real time() const { return t_; }
   real timeStep() const { return dt_; }
@@ -124,6 +126,7 @@ class FluidSolver {
   void computeVelocityGradient();
   void updatePressureGradient();
   void assembleMomentum();
+  void assembleMomentumFused();
   void computeHbyA();
   void computePhiHbyA();
   void assemblePressureMatrix();
@@ -177,7 +180,9 @@ class FluidSolver {
   /// Some internal face is non-orthogonal (S not parallel to d): the explicit corrections, and the
   /// velocity gradient they need, are live. False on Cartesian meshes, where they vanish exactly.
   bool nonOrthogonal_ = true;
-  bool hasResistance_ = false;  ///< a resistance outlet changes the boundary pressure every corrector
+  bool hasResistance_ = false;
+  /// gradU_ is what velocityGradient() promises (see there); false when the outer loop skipped it.
+  mutable bool gradUCurrent_ = false;  ///< a resistance outlet changes the boundary pressure every corrector
   real c1_ = 0, c0_ = 0, c00_ = 0;  ///< time weights: d(phi)/dt ~ (c1 phi - c0 phi0 + c00 phi00)/dt
   MeshMotion motion_;
 };
