@@ -76,8 +76,8 @@ FluidSolver::FluidSolver(const HexMesh& mesh, const FluidOptions& options)
   diagU_ = RealView("mfsi::fluid::momentum::diag", nCells_);
   cellDiag_ = RealView("mfsi::fluid::cellDiag", nCells_);
   rhsP_ = RealView("mfsi::fluid::pressure::rhs", nCells_);
-  x_ = RealView("mfsi::fluid::solveX", nCells_);
   b_ = RealView("mfsi::fluid::solveB", nCells_);
+  b3_ = Real3View("mfsi::fluid::momentum::solveB", nCells_);
   phi_ = RealView("mfsi::fluid::phi", nFaces_);
   meshPhi_ = RealView("mfsi::fluid::meshPhi", nFaces_);
   phiHbyA_ = RealView("mfsi::fluid::phiHbyA", nFaces_);
@@ -867,22 +867,18 @@ StepResult FluidSolver::solve() {
     if (pim.momentumPredictor) {
       ScopedRegion r2("mfsi::fluid::momentum::solve");
       linear_.momentumMatrixChanged(exec_, Au_);
-      for (int j = 0; j < 3; ++j) {
-        auto x = x_, b = b_;
-        auto U = U_;
-        ConstReal3View rhs = rhsU_, gp = gradP_;
-        Kokkos::parallel_for(
-            "mfsi::fluid::momentum::rhsComponent", RangePolicy(exec_, 0, nCells_), KOKKOS_LAMBDA(lid_t c) {
-              b(c) = rhs(c, j) - V(c) * gp(c, j);
-              x(c) = U(c, j);
-            });
-        const auto st = linear_.solveMomentum(exec_, Au_, b_, x_, opt_.momentumSolver);
+      // The three components share the matrix: one solve reads it once for all of them, each
+      // component stopping on its own scaled residual.
+      auto b3 = b3_;
+      ConstReal3View rhs = rhsU_, gp = gradP_;
+      Kokkos::parallel_for(
+          "mfsi::fluid::momentum::rhs", RangePolicy(exec_, 0, nCells_), KOKKOS_LAMBDA(lid_t c) {
+            for (int j = 0; j < 3; ++j) b3(c, j) = rhs(c, j) - V(c) * gp(c, j);
+          });
+      for (const auto& st : linear_.solveMomentum3(exec_, Au_, b3_, U_, opt_.momentumSolver)) {
         momRes = std::max(momRes, st.initialResidual);
         res.momentumIterations += st.iterations;
         if (st.breakdown) res.ok = false;
-        Kokkos::parallel_for(
-            "mfsi::fluid::momentum::storeComponent", RangePolicy(exec_, 0, nCells_),
-            KOKKOS_LAMBDA(lid_t c) { U(c, j) = x(c); });
       }
       updateBoundaryVelocity();
     }

@@ -157,7 +157,8 @@ class FluidSolver {
   RealView V0_, V00_;
   Real3View HbyA_, gradP_, rhsU_, bodyU_;
   Tensor3View gradU_;
-  RealView rAU_, diagU_, cellDiag_, rhsP_, x_, b_;
+  RealView rAU_, diagU_, cellDiag_, rhsP_, b_;
+  Real3View b3_;
   // Face fields.
   RealView phi_, meshPhi_, phiHbyA_, dphi_, dphi0_, dphi00_, sweptNew_, sweptOld_, fluxP_;
   Real3View fluxU_;

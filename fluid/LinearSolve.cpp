@@ -1,10 +1,46 @@
 #include "fluid/LinearSolve.hpp"
 
+#include "core/Error.hpp"
 #include "kernels/Amg.hpp"
 
+#include <algorithm>
 #include <cmath>
+#include <string>
 
 namespace mfsi::fluid {
+
+namespace {
+
+using blas::reduce;
+using blas::Sums;
+
+/// Jacobi on an inverse diagonal that LinearSolver owns and refreshes, so the one-component
+/// BiCGStab and the three-component BiCGStab3 share it.
+class SharedJacobi final : public Preconditioner {
+ public:
+  explicit SharedJacobi(const RealView& invDiag) : inv_(invDiag) {}
+  void setup(const ExecSpace& exec, const CsrMatrix& A) override { invertDiagonal(exec, A, inv_); }
+  void apply(const ExecSpace& exec, const ConstRealView& r, const RealView& z) override {
+    const ConstRealView inv = inv_;
+    Kokkos::parallel_for(
+        "mfsi::fluid::linear::jacobi", RangePolicy(exec, 0, static_cast<lid_t>(inv.extent(0))),
+        KOKKOS_LAMBDA(lid_t i) { z(i) = inv(i) * r(i); });
+  }
+  std::string name() const override { return "jacobi"; }
+
+ private:
+  RealView inv_;
+};
+
+/// The Krylov stopping tolerance on |r|_1 that is OpenFOAM's test on the scaled residual
+/// |r|_1 / nf: below tolerance, or below relTol times the initial one. A residual that is only
+/// round-off of the terms it is made of (e.g. an exactly preserved uniform flow) counts as
+/// converged: iterating would only stir round-off.
+real l1Tolerance(const LinearSolverOptions& o, real nf, real r1, real scale) {
+  return std::max({o.tolerance * nf, o.relTol * r1, 1e-14 * scale});
+}
+
+}  // namespace
 
 LinearSolver::LinearSolver() = default;
 LinearSolver::~LinearSolver() = default;
@@ -12,8 +48,7 @@ LinearSolver::LinearSolver(LinearSolver&&) noexcept = default;
 LinearSolver& LinearSolver::operator=(LinearSolver&&) noexcept = default;
 
 LinearSolver::LinearSolver(lid_t n, PressurePreconditioner pp)
-    : uPrec_(std::make_unique<JacobiPreconditioner>()),
-      uSolver_(makeKrylovSolver(KrylovMethod::BiCGStab)),
+    : uSolver_(makeKrylovSolver(KrylovMethod::BiCGStab)),
       pSolver_(makeKrylovSolver(KrylovMethod::CG)),
       r_("mfsi::fluid::linear::residual", n) {
   if (pp == PressurePreconditioner::Amg)
@@ -23,10 +58,12 @@ LinearSolver::LinearSolver(lid_t n, PressurePreconditioner pp)
 }
 
 void LinearSolver::momentumMatrixChanged(const ExecSpace& exec, const CsrMatrix& A) {
-  if (uReady_)
-    uPrec_->updateValues(exec, A);
-  else
-    uPrec_->setup(exec, A);
+  if (uInvDiag_.extent(0) != static_cast<std::size_t>(A.nRows) || !uPrec_) {
+    uInvDiag_ =
+        RealView(Kokkos::view_alloc(Kokkos::WithoutInitializing, "mfsi::fluid::linear::momentumInvDiag"), A.nRows);
+    uPrec_ = std::make_unique<SharedJacobi>(uInvDiag_);
+  }
+  invertDiagonal(exec, A, uInvDiag_);
   uReady_ = true;
 }
 
@@ -40,6 +77,7 @@ void LinearSolver::pressureMatrixChanged(const ExecSpace& exec, const CsrMatrix&
 
 LinearSolveStats LinearSolver::solveMomentum(const ExecSpace& exec, const CsrMatrix& A, const ConstRealView& b,
                                              const RealView& x, const LinearSolverOptions& o) {
+  MFSI_CHECK(uReady_, "LinearSolver::solveMomentum: momentumMatrixChanged was not called");
   return solve(exec, *uSolver_, *uPrec_, A, b, x, o);
 }
 
@@ -48,58 +86,134 @@ LinearSolveStats LinearSolver::solvePressure(const ExecSpace& exec, const CsrMat
   return solve(exec, *pSolver_, *pPrec_, A, b, x, o);
 }
 
-LinearSolveStats LinearSolver::solve(const ExecSpace& exec, KrylovSolver& solver, Preconditioner& M,
-                                     const CsrMatrix& A, const ConstRealView& b, const RealView& x,
-                                     const LinearSolverOptions& o) {
+LinearSolveStats LinearSolver::solve(const ExecSpace& exec, KrylovSolver& solver, Preconditioner& M, const CsrMatrix& A,
+                                     const ConstRealView& b, const RealView& x, const LinearSolverOptions& o) {
   LinearSolveStats st;
   const lid_t n = A.nRows;
-  // Scaled initial residual (and a round-off scale) in two passes: mean of x, then residual sums.
-  real xsum = 0;
-  Kokkos::parallel_reduce(
-      "mfsi::fluid::linear::mean", RangePolicy(exec, 0, n), KOKKOS_LAMBDA(lid_t i, real & acc) { acc += x(i); }, xsum);
-  const real xbar = n > 0 ? xsum / n : 0.0;
-  ConstIndexView rp = A.rowPtr, ci = A.colIdx;
-  ConstRealView v = A.values;
-  RealView r = r_;
-  real r1 = 0, nf = 0, scale = 0;
-  Kokkos::parallel_reduce(
-      "mfsi::fluid::linear::scaledResidual", RangePolicy(exec, 0, n),
-      KOKKOS_LAMBDA(lid_t i, real & a, real & f, real & s) {
+  const SolverComm comm;
+  if (r_.extent(0) < static_cast<std::size_t>(n)) r_ = RealView("mfsi::fluid::linear::residual", n);
+  // Two passes: the mean of x, then r = b - A x with the sums {|r|_1, normalisation factor,
+  // round-off scale, r.r}; r and its norms are the Krylov solver's starting residual.
+  const real xbar = blas::mean(exec, comm, n, x);
+  const ConstIndexView rp = A.rowPtr, ci = A.colIdx;
+  const ConstRealView v = A.values;
+  const RealView r = r_;
+  const auto s = reduce<4>(
+      exec, comm, "mfsi::fluid::linear::scaledResidual", n, KOKKOS_LAMBDA(lid_t i, Sums<4> & acc) {
         real ax = 0, rs = 0;
         for (lid_t k = rp(i); k < rp(i + 1); ++k) {
           ax += v(k) * x(ci(k));
           rs += v(k);
         }
-        r(i) = b(i) - ax;
-        a += kmath::fabs(r(i));
-        f += kmath::fabs(ax - rs * xbar) + kmath::fabs(b(i) - rs * xbar);
-        s += kmath::fabs(b(i)) + kmath::fabs(ax);
-      },
-      r1, nf, scale);
-  if (!std::isfinite(r1) || !std::isfinite(nf)) {
+        const real ri = b(i) - ax;
+        r(i) = ri;
+        acc[0] += kmath::fabs(ri);
+        acc[1] += kmath::fabs(ax - rs * xbar) + kmath::fabs(b(i) - rs * xbar);
+        acc[2] += kmath::fabs(b(i)) + kmath::fabs(ax);
+        acc[3] += ri * ri;
+      });
+  const real r1 = s[0], scale = s[2];
+  if (!std::isfinite(r1) || !std::isfinite(s[1])) {
     st.breakdown = true;
     st.initialResidual = st.finalResidual = r1;
     return st;
   }
-  nf += 1e-300;
+  const real nf = s[1] + 1e-300;
   st.initialResidual = st.finalResidual = r1 / nf;
-  // Converged already, or the residual is round-off of the terms it is made of (e.g. an exactly
-  // preserved uniform flow): iterating would only stir round-off.
-  const real roundoff = 1e-14 * scale;
-  if (st.initialResidual <= o.tolerance || r1 <= roundoff) {
-    st.converged = true;
-    return st;
-  }
   KrylovOptions ko;
-  ko.relTol = o.relTol;
-  ko.absTol = std::max(o.tolerance * nf, roundoff) / std::sqrt(static_cast<real>(n));
+  ko.relTol = 0.0;
+  ko.absTol = 0.0;
+  ko.l1AbsTol = l1Tolerance(o, nf, r1, scale);
   ko.maxIterations = o.maxIter;
   solver.setOptions(ko);
-  const KrylovResult kr = solver.solve(exec, A, b, x, M);
+  InitialResidual r0;
+  r0.r = r;
+  r0.rr = s[3];
+  r0.l1 = r1;
+  const KrylovResult kr = solver.solve(exec, A, b, x, M, r0);
   st.iterations = kr.iterations;
   st.converged = kr.converged;
   st.breakdown = kr.status == KrylovStatus::NotFinite || kr.status == KrylovStatus::Breakdown;
-  st.finalResidual = kr.initialResidual > 0 ? st.initialResidual * kr.finalResidual / kr.initialResidual : 0.0;
+  st.finalResidual = kr.finalResidualL1 / nf;
+  return st;
+}
+
+std::array<LinearSolveStats, 3> LinearSolver::solveMomentum3(const ExecSpace& exec, const CsrMatrix& A,
+                                                             const ConstReal3View& b, const Real3View& x,
+                                                             const LinearSolverOptions& o) {
+  ScopedRegion region("mfsi::fluid::linear::momentum3");
+  MFSI_CHECK(uReady_, "LinearSolver::solveMomentum3: momentumMatrixChanged was not called");
+  const lid_t n = A.nRows;
+  const lid_t nc = std::max(A.nRows, A.nCols);  // BiCGStab3 gathers its residual at neighbours
+  const SolverComm comm;
+  if (r3_.extent(0) != static_cast<std::size_t>(nc)) r3_ = Real3View("mfsi::fluid::linear::residual3", nc);
+  // The three means of x in one reduction, then one pass over A for the three columns: the row
+  // sum (for A xbar) is shared, and per column the sums {|r|_1, normalisation factor, round-off
+  // scale, r.r} - 12 sums in one deterministic reduction.
+  const auto xs = reduce<3>(
+      exec, comm, "mfsi::fluid::linear::mean3", n, KOKKOS_LAMBDA(lid_t i, Sums<3> & acc) {
+        for (int c = 0; c < 3; ++c) acc[c] += x(i, c);
+      });
+  const real nGlobal = comm.globalSum(static_cast<real>(n));
+  Kokkos::Array<real, 3> xbar;
+  for (int c = 0; c < 3; ++c) xbar[c] = nGlobal > 0 ? xs[c] / nGlobal : 0.0;
+  const ConstIndexView rp = A.rowPtr, ci = A.colIdx;
+  const ConstRealView v = A.values;
+  const Real3View r = r3_;
+  const auto s = reduce<12>(
+      exec, comm, "mfsi::fluid::linear::scaledResidual3", n, KOKKOS_LAMBDA(lid_t i, Sums<12> & acc) {
+        real ax[3] = {0, 0, 0}, rs = 0;
+        for (lid_t k = rp(i); k < rp(i + 1); ++k) {
+          const real a = v(k);
+          const lid_t j = ci(k);
+          ax[0] += a * x(j, 0);
+          ax[1] += a * x(j, 1);
+          ax[2] += a * x(j, 2);
+          rs += a;
+        }
+        for (int c = 0; c < 3; ++c) {
+          const real bi = b(i, c), ri = bi - ax[c];
+          r(i, c) = ri;
+          acc[c] += kmath::fabs(ri);
+          acc[3 + c] += kmath::fabs(ax[c] - rs * xbar[c]) + kmath::fabs(bi - rs * xbar[c]);
+          acc[6 + c] += kmath::fabs(bi) + kmath::fabs(ax[c]);
+          acc[9 + c] += ri * ri;
+        }
+      });
+
+  std::array<LinearSolveStats, 3> st;
+  std::array<KrylovOptions, 3> ko;
+  std::array<real, 3> nf{};
+  InitialResidual3 r0;
+  r0.r = r;
+  for (int c = 0; c < 3; ++c) {
+    const real r1 = s[c], scale = s[6 + c];
+    r0.rr[c] = s[9 + c];
+    r0.l1[c] = r1;
+    ko[c].relTol = 0.0;
+    ko[c].absTol = 0.0;
+    ko[c].maxIterations = o.maxIter;
+    if (!std::isfinite(r1) || !std::isfinite(s[3 + c])) {
+      // The solver leaves this column alone (a NaN residual would also stop it at once).
+      st[c].breakdown = true;
+      st[c].initialResidual = st[c].finalResidual = r1;
+      ko[c].maxIterations = 0;
+      nf[c] = 1.0;
+      continue;
+    }
+    nf[c] = s[3 + c] + 1e-300;
+    st[c].initialResidual = st[c].finalResidual = r1 / nf[c];
+    ko[c].l1AbsTol = l1Tolerance(o, nf[c], r1, scale);
+  }
+  u3Solver_.setOptions(ko);
+  const auto kr = u3Solver_.solve(exec, A, b, x, uInvDiag_, r0);
+  for (int c = 0; c < 3; ++c) {
+    if (st[c].breakdown) continue;
+    st[c].iterations = kr[c].iterations;
+    st[c].converged = kr[c].converged;
+    st[c].breakdown = kr[c].status == KrylovStatus::NotFinite || kr[c].status == KrylovStatus::Breakdown;
+    st[c].finalResidual = kr[c].finalResidualL1 / nf[c];
+  }
   return st;
 }
 

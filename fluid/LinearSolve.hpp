@@ -1,17 +1,23 @@
 #pragma once
 /// \file
 /// \brief The fluid's single entry point to the shared linear solvers of kernels/: BiCGStab with
-/// Jacobi for momentum, CG with AMG (or Jacobi) for pressure. Keeps the preconditioners between
-/// solves (the sparsity is fixed; only values are refreshed).
+/// Jacobi for momentum (one component at a time, or the three velocity components together with
+/// `BiCGStab3`), CG with AMG (or Jacobi) for pressure. Keeps the preconditioners between solves
+/// (the sparsity is fixed; only values are refreshed).
 ///
 /// Residuals are reported with OpenFOAM's scaling, |b - Ax|_1 / (|Ax - A xbar|_1 + |b - A xbar|_1)
 /// with xbar the mean of x, which depends neither on the size nor on the offset of the solution,
-/// so one tolerance serves every equation and mesh. The Krylov solvers stop on 2-norms; the
-/// scaled tolerance is turned into a 2-norm bound that implies it (|r|_1 <= sqrt(n) |r|_2).
+/// so one tolerance serves every equation and mesh. The solves stop on that same scaled residual,
+/// as OpenFOAM's do: the tolerance times the normalisation factor is the Krylov solver's 1-norm
+/// tolerance (`KrylovOptions::l1AbsTol`, summed inside reductions the solver does anyway), and relTol
+/// is a fraction of the initial 1-norm. The pass that computes the scaled initial residual also
+/// forms r = b - A x and hands it to the Krylov solver as its starting residual (no second pass).
+/// All sums are deterministic (`blas::reduce`): solves are bitwise repeatable.
 #include "fluid/FluidOptions.hpp"
 #include "kernels/CsrMatrix.hpp"
 #include "kernels/Krylov.hpp"
 
+#include <array>
 #include <memory>
 
 namespace mfsi::fluid {
@@ -20,7 +26,9 @@ namespace mfsi::fluid {
 struct LinearSolveStats {
   int iterations = 0;
   real initialResidual = 0;
-  real finalResidual = 0;  ///< initial residual times the 2-norm reduction of the Krylov solve
+  /// Scaled 1-norm of the solver's final (recursively updated) residual, with the normalisation
+  /// factor of the initial x (as OpenFOAM reports it).
+  real finalResidual = 0;
   bool converged = false;
   bool breakdown = false;  ///< NaN/inf or a Krylov breakdown
 };
@@ -41,6 +49,12 @@ class LinearSolver {
   /// \brief Solve the momentum system A x = b (x holds the initial guess).
   LinearSolveStats solveMomentum(const ExecSpace& exec, const CsrMatrix& A, const ConstRealView& b, const RealView& x,
                                  const LinearSolverOptions& o);
+  /// \brief Solve A x_c = b_c for the three velocity components c at once (x: n x 3, e.g. the
+  /// velocity field, holds the initial guess and is updated in place). One pass over A forms the
+  /// three residuals and scaled residuals; each component stops on its own scaled residual and
+  /// gets the iterates `solveMomentum` would give it. Needs `momentumMatrixChanged` first.
+  std::array<LinearSolveStats, 3> solveMomentum3(const ExecSpace& exec, const CsrMatrix& A, const ConstReal3View& b,
+                                                 const Real3View& x, const LinearSolverOptions& o);
   /// \brief Solve the (symmetric positive definite) pressure system A x = b.
   LinearSolveStats solvePressure(const ExecSpace& exec, const CsrMatrix& A, const ConstRealView& b, const RealView& x,
                                  const LinearSolverOptions& o);
@@ -51,8 +65,11 @@ class LinearSolver {
 
   std::unique_ptr<Preconditioner> uPrec_, pPrec_;
   std::unique_ptr<KrylovSolver> uSolver_, pSolver_;
+  BiCGStab3 u3Solver_;
+  RealView uInvDiag_;  ///< Jacobi of the momentum matrix, shared by uPrec_ and u3Solver_
   bool uReady_ = false, pReady_ = false;
   RealView r_;
+  Real3View r3_;
 };
 
 }  // namespace mfsi::fluid

@@ -46,6 +46,68 @@ double residual(const ExecSpace& exec, const SolverComm& comm, const CsrMatrix& 
       })[0];
 }
 
+ResidualNorms residualNorms(const ExecSpace& exec, const SolverComm& comm, const CsrMatrix& A, const ConstRealView& x,
+                            const ConstRealView& b, const RealView& r) {
+  const ConstIndexView rowPtr = A.rowPtr, colIdx = A.colIdx;
+  const ConstRealView val = A.values;
+  const auto s = reduce<2>(
+      exec, comm, "mfsi::kernels::blas::residualNorms", A.nRows, KOKKOS_LAMBDA(lid_t i, Sums<2> & acc) {
+        double ri = b(i);
+        for (lid_t k = rowPtr(i); k < rowPtr(i + 1); ++k) ri -= val(k) * x(colIdx(k));
+        r(i) = ri;
+        acc[0] += ri * ri;
+        acc[1] += kmath::fabs(ri);
+      });
+  return {s[0], s[1]};
+}
+
+void spmv(const ExecSpace& exec, const CsrMatrix& A, const ConstReal3View& x, const Real3View& y) {
+  const ConstIndexView rowPtr = A.rowPtr, colIdx = A.colIdx;
+  const ConstRealView val = A.values;
+  Kokkos::parallel_for(
+      "mfsi::kernels::blas::spmv3", RangePolicy(exec, 0, A.nRows), KOKKOS_LAMBDA(lid_t i) {
+        double s0 = 0.0, s1 = 0.0, s2 = 0.0;
+        for (lid_t k = rowPtr(i); k < rowPtr(i + 1); ++k) {
+          const double a = val(k);
+          const lid_t j = colIdx(k);
+          s0 += a * x(j, 0);
+          s1 += a * x(j, 1);
+          s2 += a * x(j, 2);
+        }
+        y(i, 0) = s0;
+        y(i, 1) = s1;
+        y(i, 2) = s2;
+      });
+}
+
+std::array<ResidualNorms, 3> residualNorms(const ExecSpace& exec, const SolverComm& comm, const CsrMatrix& A,
+                                           const ConstReal3View& x, const ConstReal3View& b, const Real3View& r) {
+  const ConstIndexView rowPtr = A.rowPtr, colIdx = A.colIdx;
+  const ConstRealView val = A.values;
+  // Sums: r.r of the three columns, then their |r|_1.
+  const auto s = reduce<6>(
+      exec, comm, "mfsi::kernels::blas::residualNorms3", A.nRows, KOKKOS_LAMBDA(lid_t i, Sums<6> & acc) {
+        double r0 = b(i, 0), r1 = b(i, 1), r2 = b(i, 2);
+        for (lid_t k = rowPtr(i); k < rowPtr(i + 1); ++k) {
+          const double a = val(k);
+          const lid_t j = colIdx(k);
+          r0 -= a * x(j, 0);
+          r1 -= a * x(j, 1);
+          r2 -= a * x(j, 2);
+        }
+        r(i, 0) = r0;
+        r(i, 1) = r1;
+        r(i, 2) = r2;
+        acc[0] += r0 * r0;
+        acc[1] += r1 * r1;
+        acc[2] += r2 * r2;
+        acc[3] += kmath::fabs(r0);
+        acc[4] += kmath::fabs(r1);
+        acc[5] += kmath::fabs(r2);
+      });
+  return {ResidualNorms{s[0], s[3]}, ResidualNorms{s[1], s[4]}, ResidualNorms{s[2], s[5]}};
+}
+
 double dot(const ExecSpace& exec, const SolverComm& comm, lid_t n, const ConstRealView& x, const ConstRealView& y) {
   return reduce<1>(
       exec, comm, "mfsi::kernels::blas::dot", n, KOKKOS_LAMBDA(lid_t i, Sums<1> & s) { s[0] += x(i) * y(i); })[0];

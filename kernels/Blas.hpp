@@ -41,6 +41,11 @@ class SolverComm {
     (void)exec;
     (void)x;
   }
+  /// \brief Same for the rows [nRows, nCols) of an n x 3 multi-vector (one exchange for all three).
+  void updateGhosts(const ExecSpace& exec, const Real3View& x) const {
+    (void)exec;
+    (void)x;
+  }
 };
 
 namespace blas {
@@ -99,6 +104,25 @@ double spmvDot(const ExecSpace& exec, const SolverComm& comm, const CsrMatrix& A
 /// \brief Fused r = b - A x; returns the global r.r.
 double residual(const ExecSpace& exec, const SolverComm& comm, const CsrMatrix& A, const ConstRealView& x,
                 const ConstRealView& b, const RealView& r);
+
+/// \brief The two norms the Krylov stopping rules use, as global sums: r.r and |r|_1 = sum |r_i|.
+struct ResidualNorms {
+  double rr = 0.0;
+  double l1 = 0.0;
+};
+
+/// \brief Fused r = b - A x; returns the global r.r and |r|_1 (r.r bitwise equal to `residual`'s).
+ResidualNorms residualNorms(const ExecSpace& exec, const SolverComm& comm, const CsrMatrix& A, const ConstRealView& x,
+                            const ConstRealView& b, const RealView& r);
+
+/// \brief Y = A X for the three columns of an n x 3 multi-vector, reading the matrix once.
+/// Column c of Y is bitwise the single-vector `spmv` of column c.
+void spmv(const ExecSpace& exec, const CsrMatrix& A, const ConstReal3View& x, const Real3View& y);
+
+/// \brief Fused R = B - A X for three columns (one matrix read); per column r.r and |r|_1, each
+/// bitwise equal to the single-vector `residualNorms` of that column.
+std::array<ResidualNorms, 3> residualNorms(const ExecSpace& exec, const SolverComm& comm, const CsrMatrix& A,
+                                           const ConstReal3View& x, const ConstReal3View& b, const Real3View& r);
 
 /// \brief Global x.y over the first n entries.
 double dot(const ExecSpace& exec, const SolverComm& comm, lid_t n, const ConstRealView& x, const ConstRealView& y);
