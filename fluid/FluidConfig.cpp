@@ -170,7 +170,7 @@ Schema fluidSchema() {
   pressure.key("finalRelTol", Schema::real("relTol of the last pressure solve of a step (pFinal; < 0: relTol)", "-").lessThan(1),
                Default(d.pressureFinalRelTol))
       .key("preconditioner", Schema::choice("conjugate-gradient preconditioner", {"amg", "jacobi"}), Default("amg"))
-      .key("preconditionerRefresh", Schema::integer("outer iterations between AMG value refreshes").atLeast(1),
+      .key("preconditionerRefresh", Schema::integer("most outer iterations between AMG value refreshes (earlier when the final pressure solve needs 25 % more iterations than after the last refresh)").atLeast(1),
            Default(d.pressurePreconditionerRefresh));
   Schema solvers = Schema::map("linear solvers")
                        .key("pressure", pressure, Presence::Optional)

@@ -172,11 +172,14 @@ struct FluidOptions {
   /// OpenFOAM's pFinal); negative: the same as pressureSolver.relTol.
   real pressureFinalRelTol = -1.0;
   PressurePreconditioner pressurePreconditioner = PressurePreconditioner::Amg;
-  /// Outer iterations between value refreshes of the pressure preconditioner, counted across time
-  /// steps (the first solve always sets it up). A slightly stale AMG hierarchy is still a good,
-  /// fixed SPD preconditioner, and its refresh costs about as much as a solve. Jacobi is refreshed
-  /// every outer iteration regardless.
-  int pressurePreconditionerRefresh = 10;
+  /// Most outer iterations between value refreshes of the pressure preconditioner, counted across
+  /// time steps (the first solve always sets it up). A slightly stale AMG hierarchy is still a
+  /// good, fixed SPD preconditioner, and its refresh costs about as much as a solve, so it is also
+  /// refreshed early only when it has gone stale: when a step's final pressure solve needs more
+  /// than `pressurePreconditionerStaleRatio` times (plus one) the iterations of the first final
+  /// solve after the last refresh. Jacobi is refreshed every outer iteration regardless.
+  int pressurePreconditionerRefresh = 50;
+  real pressurePreconditionerStaleRatio = 1.25;
   /// Used only when no boundary fixes the pressure level.
   lid_t pressureReferenceCell = 0;
   real pressureReferenceValue = 0;

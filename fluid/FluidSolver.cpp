@@ -898,7 +898,12 @@ StepResult FluidSolver::solve() {
         const int refresh = opt_.pressurePreconditioner == PressurePreconditioner::Jacobi
                                 ? 1
                                 : std::max(1, opt_.pressurePreconditionerRefresh);
-        if (corr == 0 && no == 0 && pressureAssemblies_++ % refresh == 0) linear_.pressureMatrixChanged(exec_, Ap_);
+        if (corr == 0 && no == 0 && (pressureAssemblies_++ % refresh == 0 || pressureRefreshDue_)) {
+          linear_.pressureMatrixChanged(exec_, Ap_);
+          pressureAssemblies_ = 1;
+          refreshBaselineIterations_ = -1;
+          pressureRefreshDue_ = false;
+        }
         // The last solve of the step may be tighter than the intermediate ones (pFinal).
         LinearSolverOptions ps = opt_.pressureSolver;
         const bool finalSolve =
@@ -906,6 +911,12 @@ StepResult FluidSolver::solve() {
         if (finalSolve && opt_.pressureFinalRelTol >= 0) ps.relTol = opt_.pressureFinalRelTol;
         const auto st = linear_.solvePressure(exec_, Ap_, rhsP_, p_, ps);
         gradPValid_ = false;
+        if (finalSolve && refresh > 1) {
+          if (refreshBaselineIterations_ < 0)
+            refreshBaselineIterations_ = st.iterations;
+          else if (st.iterations > opt_.pressurePreconditionerStaleRatio * refreshBaselineIterations_ + 1)
+            pressureRefreshDue_ = true;
+        }
         if (pRes < 0) pRes = st.initialResidual;
         res.pressureIterations += st.iterations;
         if (st.breakdown) res.ok = false;

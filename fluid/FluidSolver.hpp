@@ -174,6 +174,10 @@ class FluidSolver {
   /// Pressure-matrix assemblies since the preconditioner values were last refreshed, counted
   /// across steps so a one-outer-iteration PISO run does not rebuild the AMG every step.
   long pressureAssemblies_ = 0;
+  /// Iterations of the first final pressure solve after the last preconditioner refresh (-1: not
+  /// yet seen), and whether a later one has needed so many more that the next assembly refreshes.
+  int refreshBaselineIterations_ = -1;
+  bool pressureRefreshDue_ = false;
   bool bdf2Active_ = false;
   /// gradP_ (and pb_) match the current p_, boundary pressures and geometry: the gradient is the
   /// same in every place that asks for it until one of those changes (see invalidations).

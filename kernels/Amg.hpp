@@ -18,8 +18,24 @@
 ///    level (<= coarseSize rows; Eigen on the host at set-up, applied on the device).
 ///  - every kernel writes its own rows only (no atomics): the preconditioner is deterministic.
 ///
+/// Cycle (Amg.cpp): the V-cycle runs on its own copies of every level's operator, P and R,
+/// refreshed by set-up and value updates: by default in float (`AmgPrecision::Mixed`; apply()'s r
+/// and z stay double, converted by the first and last kernels), as the off-diagonal part of
+/// D^{-1}A with D^{-1}-scaled right-hand sides and residuals (no diagonal in the inner loops),
+/// and in fixed-width (ELL) rows where row lengths are nearly equal, with one-byte column
+/// patterns on structured blocks. Every Chebyshev step is one pass (x_new = x + d into a second
+/// buffer), the restriction also takes the coarse level's first smoothing step, and the
+/// coarsest pseudo-inverse is applied in double. Float rounding (1e-7 relative) perturbs the
+/// preconditioner far below what CG notices: the iteration counts are those of the double cycle.
+///
 /// Measured (tests/kernels/test_amg.cpp, 7-point Dirichlet Poisson, rough right-hand side, CG to
 /// 1e-8): 9 iterations at 16^3, 24^3 and 32^3 (Jacobi-CG: 59, 86, 116); operator complexity 1.5.
+/// perf/bench_linsolve PressureSolve (same problem): 9 / 10 / 12 iterations at 32^3 / 64^3 /
+/// 128^3 in both precisions; per CG iteration, mixed-precision cycle vs the double CSR cycle it
+/// replaced (medians, one run each, shared 2-core machine): 64^3 11.3 vs 18.0 ms on one thread,
+/// 5.9 vs 9.3 ms on two; 128^3 99 vs 152 ms on one thread, 51 vs 78 ms on two (1.5-1.6x). The
+/// double cycle with the same layouts: 1.06-1.17x. At 32^3 (cache-resident) the kernels are bound
+/// by instructions, not bytes, and float gains little (1.0-1.2x).
 ///
 /// Singular (pure Neumann) systems: aggregation keeps the constant vector in the range of every P,
 /// so every coarse operator has the same null space, and the coarsest solve is a pseudo-inverse
@@ -29,7 +45,10 @@
 ///
 /// Re-use: `setup` builds everything. `updateValues` (same sparsity, new values) keeps aggregates
 /// and the sparsity of P, R = P^T and every coarse operator, and only recomputes values on the
-/// device: diagonals, lambda_max, P, R, A_c, and the small coarsest pseudo-inverse.
+/// device: diagonals, lambda_max, P, R, A_c, the small coarsest pseudo-inverse and the cycle's
+/// copies. apply() uses the values of the last `setup`/`updateValues`/`updateFinestSmoother`:
+/// values refilled in place in the matrix given to `setup` are not seen before the next update
+/// (the preconditioner stays the fixed SPD operator of the last update).
 #include "kernels/Preconditioner.hpp"
 
 #include <memory>
@@ -43,6 +62,11 @@ struct AmgHierarchy;
 
 enum class AmgProlongation { Smoothed, Unsmoothed };
 enum class AmgSmoother { Chebyshev, Jacobi };
+/// \brief Arithmetic of the V-cycle. Mixed: every level's operator, P, R and diagonal are float
+/// copies and the cycle runs in float (apply()'s r and z stay double; the coarsest dense solve
+/// stays double); set-up and value updates compute in double either way. Mixed moves ~40 % fewer
+/// bytes per cycle for the same CG iteration counts (tests/kernels/test_amg.cpp).
+enum class AmgPrecision { Double, Mixed };
 
 /// \brief Options of the AMG preconditioner. Defaults suit the 3D pressure Poisson equation.
 struct AmgOptions {
@@ -64,7 +88,8 @@ struct AmgOptions {
   int eigenSteps = 12;                  ///< Lanczos steps estimating lambda_max(D^{-1}A) per level
   lid_t coarseSize = 200;               ///< stop coarsening at or below this many rows
   int maxLevels = 12;
-  lid_t maxDirectSize = 2000;  ///< largest coarsest level solved densely; above: 10 smoother sweeps
+  lid_t maxDirectSize = 2000;                    ///< largest coarsest level solved densely; above: 10 smoother sweeps
+  AmgPrecision precision = AmgPrecision::Mixed;  ///< arithmetic of the V-cycle
 };
 
 /// \brief One level of the hierarchy, for logs and tests.

@@ -1,6 +1,8 @@
 // Algebraic multigrid: mesh-independent CG iterations on the 3D Poisson equation (Jacobi-CG
 // iterations double from 16^3 to 32^3, AMG-CG iterations do not), singular Neumann systems,
-// value updates on a fixed sparsity, and a finite-volume matrix assembled on a graded hex mesh.
+// value updates on a fixed sparsity, and a finite-volume matrix assembled on a graded hex mesh;
+// the device cycle against a serial textbook V-cycle, and the mixed-precision (float) cycle:
+// iterations, repeatability, symmetry.
 #include "kernels/Amg.hpp"
 
 #include "core/BlockMesh.hpp"
@@ -9,8 +11,13 @@
 #include "kernels/Krylov.hpp"
 #include "support/Approx.hpp"
 
+#include <algorithm>
 #include <cmath>
+#include <cstdint>
 #include <iostream>
+#include <string>
+#include <type_traits>
+#include <utility>
 #include <vector>
 
 namespace {
@@ -428,4 +435,273 @@ TEST(Amg, TinySystemIsSolvedDirectly) {
   EXPECT_TRUE(r.converged);
   EXPECT_EQ(r.iterations, 1);
   EXPECT_LE(trueResidual(A, b, x), 1e-10 * r.initialResidual);
+}
+
+namespace {
+
+/// Host copy of a device CSR matrix, for the serial reference cycle.
+struct HostMatrix {
+  lid_t nRows = 0, nCols = 0;
+  std::vector<lid_t> ptr, col;
+  std::vector<double> val;
+  std::vector<double> apply(const std::vector<double>& x) const {
+    std::vector<double> y(nRows, 0.0);
+    for (lid_t i = 0; i < nRows; ++i)
+      for (lid_t k = ptr[i]; k < ptr[i + 1]; ++k) y[i] += val[k] * x[col[k]];
+    return y;
+  }
+  std::vector<double> applyTransposed(const std::vector<double>& x) const {
+    std::vector<double> y(nCols, 0.0);
+    for (lid_t i = 0; i < nRows; ++i)
+      for (lid_t k = ptr[i]; k < ptr[i + 1]; ++k) y[col[k]] += val[k] * x[i];
+    return y;
+  }
+  double diag(lid_t i) const {
+    for (lid_t k = ptr[i]; k < ptr[i + 1]; ++k)
+      if (col[k] == i) return val[k];
+    return 0.0;
+  }
+};
+
+HostMatrix hostMatrix(const mfsi::CsrMatrix& M) {
+  HostMatrix h;
+  h.nRows = M.nRows;
+  h.nCols = M.nCols;
+  auto rp = Kokkos::create_mirror_view_and_copy(mfsi::HostSpace(), M.rowPtr);
+  auto ci = Kokkos::create_mirror_view_and_copy(mfsi::HostSpace(), M.colIdx);
+  auto v = Kokkos::create_mirror_view_and_copy(mfsi::HostSpace(), M.values);
+  h.ptr.assign(rp.data(), rp.data() + rp.extent(0));
+  h.col.assign(ci.data(), ci.data() + ci.extent(0));
+  h.val.assign(v.data(), v.data() + v.extent(0));
+  return h;
+}
+
+/// The documented V-cycle, serially and in double, on the hierarchy of `amg` (its level matrices,
+/// prolongators and lambda_max): Chebyshev of `opt`'s degree in D^{-1}A on
+/// [1.1 lambda_max / ratio, 1.1 lambda_max] (1.1: Amg.cpp's margin over the Lanczos estimate),
+/// `sweeps` before and after the coarse correction, R = P^T, and 10 sweeps on a coarsest level
+/// that is not solved densely (set maxDirectSize = 0). Written from the textbook form, with none
+/// of the cycle's scaling, layouts or fusions.
+std::vector<double> referenceCycle(const mfsi::AmgPreconditioner& amg, std::size_t l, const std::vector<double>& b) {
+  const auto& o = amg.options();
+  const HostMatrix A = hostMatrix(amg.levelMatrix(l));
+  const auto info = amg.info();
+  const bool coarsest = l + 1 == info.levels.size();
+  const double lmax = 1.1 * info.levels[l].lambdaMax, lmin = lmax / o.chebyshevRatio;
+  const double theta = 0.5 * (lmax + lmin), delta = 0.5 * (lmax - lmin), sigma = theta / delta;
+  std::vector<double> x(A.nRows, 0.0), d(A.nRows, 0.0);
+  auto smooth = [&](int sweeps) {
+    for (int s = 0; s < sweeps; ++s) {
+      double rho = 1.0 / sigma;
+      for (int k = 0; k < o.chebyshevDegree; ++k) {
+        const double rhoNew = k == 0 ? rho : 1.0 / (2.0 * sigma - rho);
+        const double c1 = k == 0 ? 0.0 : rhoNew * rho, c2 = k == 0 ? 1.0 / theta : 2.0 * rhoNew / delta;
+        const std::vector<double> ax = A.apply(x);
+        for (lid_t i = 0; i < A.nRows; ++i) {
+          d[i] = c1 * d[i] + c2 * (b[i] - ax[i]) / A.diag(i);
+          x[i] += d[i];
+        }
+        rho = rhoNew;
+      }
+    }
+  };
+  if (coarsest) {
+    smooth(10);
+    return x;
+  }
+  smooth(o.sweeps);
+  const std::vector<double> ax = A.apply(x);
+  std::vector<double> r(A.nRows);
+  for (lid_t i = 0; i < A.nRows; ++i) r[i] = b[i] - ax[i];
+  const HostMatrix P = hostMatrix(amg.prolongator(l));
+  const std::vector<double> xc = referenceCycle(amg, l + 1, P.applyTransposed(r));
+  const std::vector<double> px = P.apply(xc);
+  for (lid_t i = 0; i < A.nRows; ++i) x[i] += px[i];
+  smooth(o.sweeps);
+  return x;
+}
+
+/// The 7-point Poisson matrix with rows and columns renumbered by a fixed pseudo-random
+/// permutation: no two rows share a column pattern relative to the row.
+mfsi::CsrMatrix shuffled(const mfsi::CsrMatrix& M) {
+  const HostMatrix h = hostMatrix(M);
+  const lid_t n = h.nRows;
+  std::vector<lid_t> perm(n);
+  for (lid_t i = 0; i < n; ++i) perm[i] = i;
+  std::uint32_t state = 12345u;
+  for (lid_t i = n - 1; i > 0; --i) {
+    state = state * 1664525u + 1013904223u;
+    std::swap(perm[i], perm[static_cast<lid_t>(state % static_cast<std::uint32_t>(i + 1))]);
+  }
+  std::vector<lid_t> inv(n);
+  for (lid_t i = 0; i < n; ++i) inv[perm[i]] = i;
+  // New row perm[i] = old row i, columns mapped and sorted.
+  std::vector<lid_t> ptr(n + 1, 0), col, diag(n);
+  std::vector<double> val;
+  for (lid_t r = 0; r < n; ++r) {
+    const lid_t i = inv[r];
+    std::vector<std::pair<lid_t, double>> row;
+    for (lid_t k = h.ptr[i]; k < h.ptr[i + 1]; ++k) row.emplace_back(perm[h.col[k]], h.val[k]);
+    std::sort(row.begin(), row.end());
+    for (const auto& [c, v] : row) {
+      if (c == r) diag[r] = static_cast<lid_t>(col.size());
+      col.push_back(c);
+      val.push_back(v);
+    }
+    ptr[r + 1] = static_cast<lid_t>(col.size());
+  }
+  mfsi::CsrMatrix out;
+  out.nRows = out.nCols = n;
+  auto upload = [](const auto& v, const std::string& label) {
+    using T = typename std::decay_t<decltype(v)>::value_type;
+    Kokkos::View<T*, mfsi::MemSpace> d(label, v.size());
+    Kokkos::deep_copy(
+        d, Kokkos::View<const T*, mfsi::HostSpace, Kokkos::MemoryTraits<Kokkos::Unmanaged>>(v.data(), v.size()));
+    return d;
+  };
+  out.rowPtr = upload(ptr, "test::rowPtr");
+  out.colIdx = upload(col, "test::colIdx");
+  out.diagIdx = upload(diag, "test::diagIdx");
+  out.values = upload(val, "test::values");
+  return out;
+}
+
+}  // namespace
+
+TEST(Amg, CycleMatchesASerialTextbookVCycle) {
+  // Kernel vs host gold. The device cycle runs on D^{-1}-scaled off-diagonal copies, in ELL rows
+  // with column patterns (natural order), ELL rows with explicit columns (shuffled order: no
+  // shared patterns), ELL4 (one cell thick, 5-point) and CSR (coarse levels), with fused
+  // smoother steps; the reference is the plain cycle on the set-up's double matrices.
+  mfsi::ExecSpace exec;
+  const auto natural = mfsi::buildPoisson7({12, 12, 12}, mfsi::ModelBoundary::Dirichlet);
+  const std::vector<std::pair<std::string, mfsi::CsrMatrix>> cases = {
+      {"12^3", natural},
+      {"12^3 shuffled", shuffled(natural)},
+      {"30x30x1 Neumann", mfsi::buildPoisson7({30, 30, 1}, mfsi::ModelBoundary::Neumann)}};
+  for (const auto& [name, A] : cases) {
+    const auto b = roughRhs(A.nRows, true);
+    std::vector<double> hb = host(b);
+    for (auto precision : {mfsi::AmgPrecision::Double, mfsi::AmgPrecision::Mixed}) {
+      mfsi::AmgOptions o;
+      o.maxDirectSize = 0;
+      o.coarseSize = 30;
+      o.precision = precision;
+      mfsi::AmgPreconditioner amg(o);
+      amg.setup(exec, A);
+      ASSERT_GE(amg.info().levels.size(), 3u) << name;
+      const std::vector<double> gold = referenceCycle(amg, 0, hb);
+      mfsi::RealView z("test::z", A.nRows);
+      amg.apply(exec, b, z);
+      const HostVec hz = host(z);
+      double scale = 0;
+      for (double v : gold) scale = std::max(scale, std::abs(v));
+      // Double: the same arithmetic up to the order of operations. Mixed: float rounding, a few
+      // 1e-7 relative per operation, through ~20 operations per level.
+      const bool dbl = precision == mfsi::AmgPrecision::Double;
+      const Tol tol = dbl ? Tol{1e-12 * scale, 1e-11} : Tol{1e-5 * scale, 1e-5};
+      EXPECT_TRUE(mfsi::test::allNear(hz, gold, gold.size(), tol, name + (dbl ? " double" : " mixed")));
+      if (!dbl) {
+        // Mixed really runs in float: it differs from the double cycle by rounding.
+        double maxDiff = 0;
+        for (std::size_t i = 0; i < gold.size(); ++i) maxDiff = std::max(maxDiff, std::abs(hz[i] - gold[i]));
+        EXPECT_GT(maxDiff, 1e-10 * scale) << name;
+      }
+    }
+  }
+}
+
+TEST(Amg, MixedPrecisionKeepsIterationsAndIsRepeatable) {
+  mfsi::ExecSpace exec;
+  const mfsi::SolverComm comm;
+  mfsi::AmgOptions dbl, mixed;
+  dbl.precision = mfsi::AmgPrecision::Double;
+  mixed.precision = mfsi::AmgPrecision::Mixed;
+
+  // Dirichlet 32^3: the mixed cycle converges CG to 1e-8 in at most one iteration more.
+  const auto A = mfsi::buildPoisson7({32, 32, 32}, mfsi::ModelBoundary::Dirichlet);
+  const auto b = roughRhs(A.nRows, false);
+  mfsi::AmgPreconditioner amgD(dbl), amgM(mixed);
+  amgD.setup(exec, A);
+  amgM.setup(exec, A);
+  mfsi::RealView xd, xm;
+  const auto rd = solveCg(A, b, amgD, xd);
+  const auto rm = solveCg(A, b, amgM, xm);
+  ASSERT_TRUE(rd.converged && rm.converged);
+  std::cout << "[ amg      ] 32^3 Dirichlet: double cycle " << rd.iterations << " its, mixed " << rm.iterations
+            << " its\n";
+  EXPECT_LE(rm.iterations, rd.iterations + 1);
+  EXPECT_LE(trueResidual(A, b, xm), 2e-8 * rm.initialResidual);
+
+  // Bitwise repeatable: the same solve again, and with a second preconditioner set up alike.
+  mfsi::AmgPreconditioner amgM2(mixed);
+  amgM2.setup(exec, A);
+  mfsi::RealView xm2, xm3;
+  const auto rm2 = solveCg(A, b, amgM, xm2);
+  const auto rm3 = solveCg(A, b, amgM2, xm3);
+  EXPECT_EQ(rm2.iterations, rm.iterations);
+  EXPECT_EQ(rm3.iterations, rm.iterations);
+  const HostVec h1 = host(xm), h2 = host(xm2), h3 = host(xm3);
+  std::size_t diff2 = 0, diff3 = 0;
+  for (std::size_t i = 0; i < h1.size(); ++i) {
+    diff2 += h1[i] != h2[i] ? 1 : 0;
+    diff3 += h1[i] != h3[i] ? 1 : 0;
+  }
+  EXPECT_EQ(diff2, 0u);
+  EXPECT_EQ(diff3, 0u);
+
+  // Pure Neumann (singular), consistent right-hand side: converges to the zero-mean solution.
+  const auto N = mfsi::buildPoisson7({20, 18, 16}, mfsi::ModelBoundary::Neumann);
+  const auto bn = roughRhs(N.nRows, true);
+  mfsi::AmgPreconditioner nD(dbl), nM(mixed);
+  nD.setup(exec, N);
+  nM.setup(exec, N);
+  const auto nd = solveCg(N, bn, nD, xd, mfsi::NullSpace::Constant);
+  const auto nm = solveCg(N, bn, nM, xm, mfsi::NullSpace::Constant);
+  ASSERT_TRUE(nd.converged && nm.converged) << mfsi::toString(nm.status);
+  std::cout << "[ amg      ] 20x18x16 Neumann: double cycle " << nd.iterations << " its, mixed " << nm.iterations
+            << " its\n";
+  EXPECT_LE(nm.iterations, nd.iterations + 1);
+  EXPECT_LE(trueResidual(N, bn, xm), 2e-8 * nm.initialResidual);
+  EXPECT_TRUE(near(mfsi::blas::mean(exec, comm, N.nRows, xm), 0.0, Tol{1e-12, 0}, "mean of x"));
+}
+
+TEST(Amg, VCycleIsSymmetricAndPositive) {
+  // Plain CG needs a symmetric positive (semi)definite preconditioner: <M u, v> = <u, M v> and
+  // <M u, u> > 0, here for two rough vectors, on an SPD and a singular (Neumann, zero-mean
+  // vectors) matrix. Float rounding breaks the symmetry at the 1e-7 level only.
+  mfsi::ExecSpace exec;
+  const mfsi::SolverComm comm;
+  for (auto bc : {mfsi::ModelBoundary::Dirichlet, mfsi::ModelBoundary::Neumann}) {
+    const auto A = mfsi::buildPoisson7({16, 14, 12}, bc);
+    const lid_t n = A.nRows;
+    const bool neumann = bc == mfsi::ModelBoundary::Neumann;
+    const auto u = roughRhs(n, neumann);
+    mfsi::RealView v("test::v", n);
+    {
+      auto h = Kokkos::create_mirror_view(v);
+      double s = 0;
+      for (lid_t i = 0; i < n; ++i) s += (h(i) = std::cos(1.3 * i) - 0.2 * std::sin(0.021 * i * i));
+      if (neumann)
+        for (lid_t i = 0; i < n; ++i) h(i) -= s / n;
+      Kokkos::deep_copy(v, h);
+    }
+    for (auto precision : {mfsi::AmgPrecision::Double, mfsi::AmgPrecision::Mixed}) {
+      mfsi::AmgOptions o;
+      o.precision = precision;
+      mfsi::AmgPreconditioner amg(o);
+      amg.setup(exec, A);
+      mfsi::RealView mu("test::mu", n), mv("test::mv", n);
+      amg.apply(exec, u, mu);
+      amg.apply(exec, v, mv);
+      const double muv = mfsi::blas::dot(exec, comm, n, mu, v), umv = mfsi::blas::dot(exec, comm, n, u, mv);
+      const double muu = mfsi::blas::dot(exec, comm, n, mu, u), mvv = mfsi::blas::dot(exec, comm, n, mv, v);
+      const double rel = precision == mfsi::AmgPrecision::Double ? 1e-12 : 1e-5;
+      const std::string what = std::string(neumann ? "Neumann" : "Dirichlet") +
+                               (precision == mfsi::AmgPrecision::Double ? " double" : " mixed");
+      EXPECT_TRUE(near(muv, umv, Tol{0, rel * std::sqrt(muu * mvv)}, what + " <Mu,v> vs <u,Mv>"));
+      EXPECT_GT(muu, 0.0) << what;
+      EXPECT_GT(mvv, 0.0) << what;
+    }
+  }
 }
