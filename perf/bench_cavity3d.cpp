@@ -14,15 +14,19 @@
 // Settings, chosen to be as close to icoFoam's as our solver allows:
 //  - PISO: 1 outer iteration, momentum predictor, 2 pressure correctors, no non-orthogonal corrector;
 //  - implicit Euler, central (Gauss linear) convection, Green-Gauss gradients;
-//  - momentum: BiCGStab + Jacobi, scaled residual 1e-5, relTol 0 (icoFoam: symGaussSeidel, 1e-5);
+//  - momentum: the three components in one BiCGStab3 + Jacobi solve, scaled residual 1e-5, relTol 0
+//    (icoFoam: symGaussSeidel, 1e-5); every solve stops on OpenFOAM's scaled 1-norm residual;
 //  - pressure: CG + smoothed-aggregation AMG, scaled residual 1e-6, relTol 0.05 on the first
 //    corrector and 0 on the final one (pFinal), as icoFoam's GAMG settings. The AMG values are
-//    refreshed every 10 pressure assemblies (a stale hierarchy is still an SPD preconditioner).
+//    refreshed at most every 50 pressure assemblies, earlier when the final solve slows down (a
+//    stale hierarchy is still an SPD preconditioner); the V-cycle runs in float.
 //
 // Second argument 1 = profile: Kokkos Tools region callbacks accumulate inclusive wall time per
 // solver phase (fluid::momentum::assemble, ...::solve, fluid::pressure::assemble, ...::solve,
 // kernels::amg::*) and report them as fractions of the timed steps. It is a separate run because
 // any registered tool callback puts every kernel launch on Kokkos' profiling path.
+// Second argument 2 = the same plus the wall time of every kernel per step, printed to stderr
+// (exact on host backends, where a launch returns when the kernel is done).
 #include "support/BenchMain.hpp"
 
 #include "core/BlockMesh.hpp"
