@@ -48,6 +48,7 @@ FluidSolver::FluidSolver(const HexMesh& mesh, const FluidOptions& options)
 
   geo_ = allocateGeometry(mesh);
   fd_ = allocateFaceData(mesh);
+  if (opt_.gradient == GradientScheme::GaussLinear) gradStencil_ = allocateGradientStencil(mesh);
   sparsity_ = buildSparsity(mesh);
   Au_ = makeMatrix(sparsity_, "mfsi::fluid::momentum::matrix");
   Ap_ = makeMatrix(sparsity_, "mfsi::fluid::pressure::matrix");
@@ -123,6 +124,7 @@ FluidSolver::FluidSolver(const HexMesh& mesh, const FluidOptions& options)
 void FluidSolver::updateGeometry() {
   computeGeometry(exec_, mesh_, geo_);
   computeFaceData(exec_, mesh_, geo_, fd_);
+  if (opt_.gradient == GradientScheme::GaussLinear) computeGradientStencil(exec_, mesh_, geo_, fd_, gradStencil_);
   gradPValid_ = false;
   // Largest |k_f| / |S_f| of the non-orthogonal part of the internal face area vectors.
   ConstReal3View k = fd_.nonOrth;
@@ -348,21 +350,34 @@ void FluidSolver::updatePressureGradient() {
   // Only the cells next to the boundary see the boundary values, so the second pass updates
   // those alone.
   updateBoundaryPressure();
-  cellGradient(exec_, opt_.gradient, mesh_, geo_, fd_, p_, pb_, gradP_);
+  pressureGradient({});
   if (opt_.wallPressure == WallPressure::Extrapolated) {
     updateBoundaryPressure();
-    cellGradient(exec_, opt_.gradient, mesh_, geo_, fd_, p_, pb_, gradP_, boundaryCells_);
+    pressureGradient(boundaryCells_);
   }
   gradPValid_ = true;
 }
 
+void FluidSolver::pressureGradient(const ConstIndexView& cells) {
+  if (opt_.gradient == GradientScheme::GaussLinear)
+    cellGradient(exec_, mesh_, gradStencil_, p_, pb_, gradP_, cells);
+  else
+    cellGradient(exec_, opt_.gradient, mesh_, geo_, fd_, p_, pb_, gradP_, cells);
+}
+
 void FluidSolver::computeVelocityGradient() {
-  cellGradient(exec_, opt_.gradient, mesh_, geo_, fd_, U_, Ub_, gradU_);
+  if (opt_.gradient == GradientScheme::GaussLinear)
+    cellGradient(exec_, mesh_, gradStencil_, U_, Ub_, gradU_);
+  else
+    cellGradient(exec_, opt_.gradient, mesh_, geo_, fd_, U_, Ub_, gradU_);
 }
 
 ConstTensor3View FluidSolver::velocityGradient() const {
   if (!gradUCurrent_) {
-    cellGradient(exec_, opt_.gradient, mesh_, geo_, fd_, U_, Ub_, gradU_);
+    if (opt_.gradient == GradientScheme::GaussLinear)
+      cellGradient(exec_, mesh_, gradStencil_, U_, Ub_, gradU_);
+    else
+      cellGradient(exec_, opt_.gradient, mesh_, geo_, fd_, U_, Ub_, gradU_);
     gradUCurrent_ = true;
   }
   return gradU_;

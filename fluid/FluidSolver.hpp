@@ -124,6 +124,7 @@ class FluidSolver {
   void updateBoundaryVelocity();
   void updateBoundaryPressure();
   void computeVelocityGradient();
+  void pressureGradient(const ConstIndexView& cells);
   void updatePressureGradient();
   void assembleMomentum();
   void assembleMomentumFused();
@@ -166,6 +167,7 @@ class FluidSolver {
   Real3View Ub_, faceMeshVel_;
   RealView pb_;
   IndexView boundaryCells_;  ///< cells owning a boundary face
+  GradientStencil gradStencil_;  ///< Gauss-linear gradients (rebuilt with the geometry)
   // Mesh positions at the start of the step.
   Real3View points0_;
 

@@ -114,6 +114,96 @@ void cellGradient(const ExecSpace& exec, GradientScheme scheme, const HexMesh& m
   gradientImpl<3>(exec, scheme, mesh, geo, fd, u, uB, grad, cells);
 }
 
+GradientStencil allocateGradientStencil(const HexMesh& mesh) {
+  const lid_t entries = static_cast<lid_t>(mesh.cellFaces().extent(0));
+  GradientStencil st;
+  st.self = Real3View("mfsi::fluid::gradientStencil::self", mesh.nCells());
+  st.other = IndexView("mfsi::fluid::gradientStencil::other", entries);
+  st.coef = Real3View("mfsi::fluid::gradientStencil::coef", entries);
+  return st;
+}
+
+void computeGradientStencil(const ExecSpace& exec, const HexMesh& mesh, const MeshGeometry& geo, const FvFaceData& fd,
+                            const GradientStencil& st) {
+  ConstIndexView off = mesh.cellFaceOffsets(), cf = mesh.cellFaces(), own = mesh.faceOwner(),
+                 nei = mesh.faceNeighbour();
+  ConstReal3View sf = geo.faceArea;
+  ConstRealView vol = geo.cellVolume, w = fd.weight;
+  const lid_t nIn = mesh.nInternalFaces();
+  auto self = st.self;
+  auto other = st.other;
+  auto coef = st.coef;
+  Kokkos::parallel_for(
+      "mfsi::fluid::gradientStencil::compute", RangePolicy(exec, 0, mesh.nCells()), KOKKOS_LAMBDA(lid_t c) {
+        const real rv = 1.0 / vol(c);
+        real sc[3] = {0, 0, 0};
+        for (lid_t e = off(c); e < off(c + 1); ++e) {
+          const lid_t f = cf(e);
+          // Face value w phi_owner + (1 - w) phi_neighbour, with S_f pointing out of the owner.
+          real wSelf = 1.0, wOther = 0.0, sgn = 1.0;
+          if (f < nIn) {
+            const bool isOwner = own(f) == c;
+            sgn = isOwner ? 1.0 : -1.0;
+            wSelf = isOwner ? w(f) : 1.0 - w(f);
+            wOther = 1.0 - wSelf;
+            other(e) = isOwner ? nei(f) : own(f);
+          } else {
+            wSelf = 0.0;
+            wOther = 1.0;
+            other(e) = -(f - nIn + 1);
+          }
+          for (int i = 0; i < 3; ++i) {
+            const real s = sgn * sf(f, i) * rv;
+            sc[i] += wSelf * s;
+            coef(e, i) = wOther * s;
+          }
+        }
+        for (int i = 0; i < 3; ++i) self(c, i) = sc[i];
+      });
+}
+
+namespace {
+
+template <int NC, class F, class FB, class G>
+void stencilGradient(const ExecSpace& exec, const HexMesh& mesh, const GradientStencil& st, const F& phi,
+                     const FB& phiB, const G& grad, const ConstIndexView& cells) {
+  using detail::comp;
+  const bool listed = cells.extent(0) > 0;
+  const lid_t count = listed ? static_cast<lid_t>(cells.extent(0)) : mesh.nCells();
+  ConstIndexView off = mesh.cellFaceOffsets(), other = st.other;
+  ConstReal3View self = st.self, coef = st.coef;
+  Kokkos::parallel_for(
+      "mfsi::fluid::gradient::gaussStencil", RangePolicy(exec, 0, count), KOKKOS_LAMBDA(lid_t i) {
+        const lid_t c = listed ? cells(i) : i;
+        real g[3][NC];
+        for (int k = 0; k < NC; ++k) {
+          const real v = comp(phi, c, k);
+          for (int d = 0; d < 3; ++d) g[d][k] = self(c, d) * v;
+        }
+        for (lid_t e = off(c); e < off(c + 1); ++e) {
+          const lid_t o = other(e);
+          for (int k = 0; k < NC; ++k) {
+            const real v = o >= 0 ? comp(phi, o, k) : comp(phiB, -o - 1, k);
+            for (int d = 0; d < 3; ++d) g[d][k] += coef(e, d) * v;
+          }
+        }
+        for (int d = 0; d < 3; ++d)
+          for (int k = 0; k < NC; ++k) store(grad, c, d, k, g[d][k]);
+      });
+}
+
+}  // namespace
+
+void cellGradient(const ExecSpace& exec, const HexMesh& mesh, const GradientStencil& st, const ConstRealView& phi,
+                  const ConstRealView& phiB, const Real3View& grad, const ConstIndexView& cells) {
+  stencilGradient<1>(exec, mesh, st, phi, phiB, grad, cells);
+}
+
+void cellGradient(const ExecSpace& exec, const HexMesh& mesh, const GradientStencil& st, const ConstReal3View& u,
+                  const ConstReal3View& uB, const Tensor3View& grad, const ConstIndexView& cells) {
+  stencilGradient<3>(exec, mesh, st, u, uB, grad, cells);
+}
+
 IndexView boundaryCells(const HexMesh& mesh) {
   auto own = Kokkos::create_mirror_view_and_copy(HostSpace(), mesh.faceOwner());
   std::vector<lid_t> cells;

@@ -111,5 +111,5 @@ TEST(MomentumAssembly, VelocityGradientIsServedWhenTheSolverSkippedIt) {
         diff = std::max(diff, std::abs(hg(c, i, j) - he(c, i, j)));
       }
   ASSERT_GT(gmax, 0.5);  // a sheared flow, not the zero-initialised array
-  EXPECT_EQ(diff, 0.0);
+  EXPECT_LE(diff, 1e-12 * gmax);  // the solver's stencil form of the same gradient
 }
