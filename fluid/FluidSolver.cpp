@@ -365,7 +365,8 @@ void FluidSolver::pressureGradient(const ConstIndexView& cells) {
     cellGradient(exec_, opt_.gradient, mesh_, geo_, fd_, p_, pb_, gradP_, cells);
 }
 
-void FluidSolver::computeVelocityGradient() {
+void FluidSolver::computeVelocityGradient() const {
+  // const: velocityGradient() fills the (mutable through its View handle) gradU_ on request.
   if (opt_.gradient == GradientScheme::GaussLinear)
     cellGradient(exec_, mesh_, gradStencil_, U_, Ub_, gradU_);
   else
@@ -374,10 +375,7 @@ void FluidSolver::computeVelocityGradient() {
 
 ConstTensor3View FluidSolver::velocityGradient() const {
   if (!gradUCurrent_) {
-    if (opt_.gradient == GradientScheme::GaussLinear)
-      cellGradient(exec_, mesh_, gradStencil_, U_, Ub_, gradU_);
-    else
-      cellGradient(exec_, opt_.gradient, mesh_, geo_, fd_, U_, Ub_, gradU_);
+    computeVelocityGradient();
     gradUCurrent_ = true;
   }
   return gradU_;

@@ -123,7 +123,7 @@ class FluidSolver {
   void computeMeshFlux();
   void updateBoundaryVelocity();
   void updateBoundaryPressure();
-  void computeVelocityGradient();
+  void computeVelocityGradient() const;
   void pressureGradient(const ConstIndexView& cells);
   void updatePressureGradient();
   void assembleMomentum();

@@ -40,6 +40,14 @@ double interpCubic(const std::vector<double>& x, const std::vector<double>& y, d
   return r;
 }
 
+// Linear interpolation between the two samples around s (x sorted ascending, >= 2 samples).
+double interpLinear(const std::vector<double>& x, const std::vector<double>& y, double s) {
+  std::size_t k = 0;
+  while (k + 2 < x.size() && x[k + 1] < s) ++k;
+  const double w = (s - x[k]) / (x[k + 1] - x[k]);
+  return (1 - w) * y[k] + w * y[k + 1];
+}
+
 // Profile of velocity component `comp` along the centreline `lineAxis` (the line sits at the middle
 // of `crossAxis`): one sample per cell row, interpolated linearly across the line between the
 // nearest centroids on either side. Rows are cells with equal `lineAxis` centroid coordinate.
@@ -108,10 +116,13 @@ GhiaErrors ghiaErrors(const FluidSolver& fluid, int re, double lidSpeed) {
   v.push_back(0.0);
   GhiaErrors e;
   for (const auto& g : table) {
-    if (g.uLine)
+    if (g.uLine) {
       e.uMax = std::max(e.uMax, std::abs(interpCubic(y, u, g.coord) - g.value));
-    else
+      e.uMaxLinear = std::max(e.uMaxLinear, std::abs(interpLinear(y, u, g.coord) - g.value));
+    } else {
       e.vMax = std::max(e.vMax, std::abs(interpCubic(x, v, g.coord) - g.value));
+      e.vMaxLinear = std::max(e.vMaxLinear, std::abs(interpLinear(x, v, g.coord) - g.value));
+    }
   }
   return e;
 }

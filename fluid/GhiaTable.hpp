@@ -26,6 +26,9 @@ const std::vector<GhiaPoint>& ghiaTable(int re);
 struct GhiaErrors {
   double uMax = 0;  ///< max over the table's y of |u(x_c, y) / U_lid - u_Ghia|
   double vMax = 0;  ///< max over the table's x of |v(x, y_c) / U_lid - v_Ghia|
+  /// The same with linear instead of cubic interpolation between the profile samples, which is how
+  /// perf/openfoam/cavity_ghia.py samples OpenFOAM's fields (for like-for-like comparisons).
+  double uMaxLinear = 0, vMaxLinear = 0;
 };
 
 /// \brief Compare a cavity solution with Ghia's table at `re`. The cavity is the bounding box of

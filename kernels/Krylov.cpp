@@ -123,6 +123,22 @@ RealView workResidual(const InitialResidual* r0, RealView& own, lid_t n, const c
   return r0->r;
 }
 
+/// Row i of A M^{-1} X for the three columns of X, M = diag(1 / inv): the Jacobi scaling is formed
+/// inside the gather, so A and inv are read once for all columns (BiCGStab3's two products).
+KOKKOS_INLINE_FUNCTION void jacobiRow3(const ConstIndexView& rowPtr, const ConstIndexView& colIdx,
+                                       const ConstRealView& val, const ConstRealView& inv, const Real3View& x,
+                                       lid_t i, double out[3]) {
+  out[0] = out[1] = out[2] = 0.0;
+  for (lid_t k = rowPtr(i); k < rowPtr(i + 1); ++k) {
+    const double a = val(k);
+    const lid_t j = colIdx(k);
+    const double d = inv(j);
+    out[0] += a * (d * x(j, 0));
+    out[1] += a * (d * x(j, 1));
+    out[2] += a * (d * x(j, 2));
+  }
+}
+
 }  // namespace
 
 // ---------------------------------------------------------------------------------------------
@@ -492,15 +508,8 @@ std::array<KrylovResult, 3> BiCGStab3::run(const ExecSpace& exec, const CsrMatri
     comm_.updateGhosts(exec, p);
     const auto rv = reduce<3>(
         exec, comm_, "mfsi::kernels::krylov::bicgstab3::v", n, KOKKOS_LAMBDA(lid_t i, Sums<3> & acc) {
-          double av[3] = {0.0, 0.0, 0.0};
-          for (lid_t k = rowPtr(i); k < rowPtr(i + 1); ++k) {
-            const double a = val(k);
-            const lid_t j = colIdx(k);
-            const double d = inv(j);
-            av[0] += a * (d * p(j, 0));
-            av[1] += a * (d * p(j, 1));
-            av[2] += a * (d * p(j, 2));
-          }
+          double av[3];
+          jacobiRow3(rowPtr, colIdx, val, inv, p, i, av);
           // Written for every column: v of a frozen column is never read again (cheaper than
           // branching per row).
           for (int c = 0; c < 3; ++c) {
@@ -561,15 +570,8 @@ std::array<KrylovResult, 3> BiCGStab3::run(const ExecSpace& exec, const CsrMatri
       comm_.updateGhosts(exec, r);
       const auto ts = reduce<6>(
           exec, comm_, "mfsi::kernels::krylov::bicgstab3::t", n, KOKKOS_LAMBDA(lid_t i, Sums<6> & acc) {
-            double at[3] = {0.0, 0.0, 0.0};
-            for (lid_t k = rowPtr(i); k < rowPtr(i + 1); ++k) {
-              const double a = val(k);
-              const lid_t j = colIdx(k);
-              const double d = inv(j);
-              at[0] += a * (d * r(j, 0));
-              at[1] += a * (d * r(j, 1));
-              at[2] += a * (d * r(j, 2));
-            }
+            double at[3];
+            jacobiRow3(rowPtr, colIdx, val, inv, r, i, at);
             for (int c = 0; c < 3; ++c) {  // every column, as in K2
               t(i, c) = at[c];
               acc[c] += at[c] * r(i, c);
