@@ -39,8 +39,6 @@ bench=$build/perf/bench_cavity3d
 [ -x "$bench" ] || { echo "no $bench: build target bench_cavity3d (MFSI_BUILD=...)" >&2; exit 1; }
 out_dir=$here/results
 mkdir -p "$out_dir"
-dt=$(python3 -c "print(0.32 / $n)")
-end=$(python3 -c "print(repr($steps * 0.32 / $n))")
 
 if [ "${MFSI_GHIA:-0}" = 1 ]; then
   ghia_exe=$build/tests/mfsi_fluid_test_cavity_ghia
@@ -71,17 +69,7 @@ json.dump({"what": "2D lid-driven cavity Re=100, ours vs Ghia et al. 1982 (17 po
 PY
 fi
 
-case=$WORK/cavity3d_N$n
-make_case cavity "$case" N="$n" NZ="$n" LZ=1 FB_TYPE=wall FB_U=noSlip FB_P=zeroGradient \
-  DT="$dt" END_TIME="$end" WRITE_CONTROL=timeStep WRITE_INTERVAL=1000000 NCORR=2 NP=2
-run_foam "$case" log.blockMesh blockMesh
-run_foam "$case" log.decomposePar decomposePar -force
-
-stamp() { python3 -u -c '
-import sys, time
-for line in sys.stdin:
-    sys.stdout.write("%.6f %s" % (time.time(), line))
-    sys.stdout.flush()'; }
+cavity3d_case "$n" "$steps"
 
 ours() {  # ours THREADS PROFILE JSON
   OMP_PROC_BIND=spread OMP_PLACES=cores OMP_NUM_THREADS=$1 MFSI_CAVITY3D_N=$n MFSI_CAVITY3D_STEPS=$steps \

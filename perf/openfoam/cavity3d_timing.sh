@@ -32,19 +32,7 @@ source "$(dirname "${BASH_SOURCE[0]}")/foam_env.sh"
 n=${1:-64}
 steps=${2:-20}
 repeats=${3:-3}
-dt=$(python3 -c "print(0.32 / $n)")
-end=$(python3 -c "print(repr($steps * 0.32 / $n))")
-case=$WORK/cavity3d_N$n
-make_case cavity "$case" N="$n" NZ="$n" LZ=1 FB_TYPE=wall FB_U=noSlip FB_P=zeroGradient \
-  DT="$dt" END_TIME="$end" WRITE_CONTROL=timeStep WRITE_INTERVAL=1000000 NCORR=2 NP=2
-run_foam "$case" log.blockMesh blockMesh
-run_foam "$case" log.decomposePar decomposePar -force
-
-stamp() { python3 -u -c '
-import sys, time
-for line in sys.stdin:
-    sys.stdout.write("%.6f %s" % (time.time(), line))
-    sys.stdout.flush()'; }
+cavity3d_case "$n" "$steps"
 
 runs=()
 for r in $(seq 1 "$repeats"); do

@@ -42,3 +42,24 @@ run_foam() {
 }
 
 load_note() { echo "$(date -u +%FT%TZ) $(uptime | sed 's/.*load average/load average/')"; }
+
+# cavity3d_case N STEPS: the 3D lid-driven cube cavity timing case (N^3 cells, dt = 0.32 / N,
+# STEPS steps, no output, decomposed into 2 slabs), meshed and decomposed in $WORK/cavity3d_N<N>;
+# sets `case`, `dt` and `end`.
+cavity3d_case() {
+  local n=$1 steps=$2
+  dt=$(python3 -c "print(0.32 / $n)")
+  end=$(python3 -c "print(repr($steps * 0.32 / $n))")
+  case=$WORK/cavity3d_N$n
+  make_case cavity "$case" N="$n" NZ="$n" LZ=1 FB_TYPE=wall FB_U=noSlip FB_P=zeroGradient \
+    DT="$dt" END_TIME="$end" WRITE_CONTROL=timeStep WRITE_INTERVAL=1000000 NCORR=2 NP=2
+  run_foam "$case" log.blockMesh blockMesh
+  run_foam "$case" log.decomposePar decomposePar -force
+}
+
+# stamp: prefix every line of stdin with the wall time it arrived at (for timing solver logs).
+stamp() { python3 -u -c '
+import sys, time
+for line in sys.stdin:
+    sys.stdout.write("%.6f %s" % (time.time(), line))
+    sys.stdout.flush()'; }
