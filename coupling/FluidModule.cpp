@@ -14,39 +14,17 @@ namespace {
 // Pressure at a point: on a patch, the boundary values of the two nearest faces blended by inverse
 // distance (they are extrapolated from the wall cells); otherwise the value of the nearest cell.
 double pressureAt(const FluidSolver& fluid, const Vec3& x, const std::string& patch) {
-  const HexMesh& mesh = fluid.mesh();
-  auto dist = [&](const auto& C, int i) {
+  if (!patch.empty()) return boundaryPressureAt(fluid, patch, x);
+  auto C = Kokkos::create_mirror_view_and_copy(HostSpace(), fluid.geometry().cellCentroid);
+  auto p = Kokkos::create_mirror_view_and_copy(HostSpace(), fluid.pressure());
+  auto dist = [&](int i) {
     return std::sqrt((C(i, 0) - x[0]) * (C(i, 0) - x[0]) + (C(i, 1) - x[1]) * (C(i, 1) - x[1]) +
                      (C(i, 2) - x[2]) * (C(i, 2) - x[2]));
   };
-  if (patch.empty()) {
-    auto C = Kokkos::create_mirror_view_and_copy(HostSpace(), fluid.geometry().cellCentroid);
-    auto p = Kokkos::create_mirror_view_and_copy(HostSpace(), fluid.pressure());
-    int best = 0;
-    for (int c = 1; c < mesh.nCells(); ++c)
-      if (dist(C, c) < dist(C, best)) best = c;
-    return p(best);
-  }
-  const auto& pt = mesh.patches()[mesh.patchIndex(patch)];
-  auto fc = Kokkos::create_mirror_view_and_copy(HostSpace(), fluid.geometry().faceCentroid);
-  auto pb = Kokkos::create_mirror_view_and_copy(HostSpace(), fluid.boundaryPressure());
-  const int nIn = mesh.nInternalFaces();
-  int f1 = -1, f2 = -1;
-  double d1 = 1e300, d2 = 1e300;
-  for (int f = pt.start; f < pt.start + pt.size; ++f) {
-    const double d = dist(fc, f);
-    if (d < d1) {
-      f2 = f1;
-      d2 = d1;
-      f1 = f;
-      d1 = d;
-    } else if (d < d2) {
-      f2 = f;
-      d2 = d;
-    }
-  }
-  if (f2 < 0 || d1 < 1e-12) return pb(f1 - nIn);
-  return (pb(f1 - nIn) / d1 + pb(f2 - nIn) / d2) / (1 / d1 + 1 / d2);
+  int best = 0;
+  for (int c = 1; c < fluid.mesh().nCells(); ++c)
+    if (dist(c) < dist(best)) best = c;
+  return p(best);
 }
 
 double dot(const Vec3& a, const Vec3& b) { return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]; }

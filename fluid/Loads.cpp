@@ -2,6 +2,8 @@
 
 #include "core/Error.hpp"
 
+#include <cmath>
+
 namespace mfsi::fluid {
 
 namespace {
@@ -104,6 +106,32 @@ void baffleNetPressure(const FluidSolver& fluid, const std::string& baffle, cons
   Kokkos::parallel_for(
       "mfsi::fluid::loads::baffleNetPressure", RangePolicy(ExecSpace(), 0, pm.size),
       KOKKOS_LAMBDA(lid_t i) { pNet(i) = pb(m0 + i) - pb(s0 + i); });
+}
+
+real boundaryPressureAt(const FluidSolver& fluid, const std::string& patch, const Vec3& x) {
+  const HexMesh& mesh = fluid.mesh();
+  const auto& pt = mesh.patches()[mesh.patchIndex(patch)];
+  MFSI_CHECK(pt.size > 0, "fluid: boundaryPressureAt: patch '" << patch << "' has no faces");
+  auto fc = Kokkos::create_mirror_view_and_copy(HostSpace(), fluid.geometry().faceCentroid);
+  auto pb = Kokkos::create_mirror_view_and_copy(HostSpace(), fluid.boundaryPressure());
+  const lid_t nIn = mesh.nInternalFaces();
+  lid_t f1 = -1, f2 = -1;
+  double d1 = 1e300, d2 = 1e300;
+  for (lid_t f = pt.start; f < pt.start + pt.size; ++f) {
+    const double d = std::sqrt((fc(f, 0) - x[0]) * (fc(f, 0) - x[0]) + (fc(f, 1) - x[1]) * (fc(f, 1) - x[1]) +
+                               (fc(f, 2) - x[2]) * (fc(f, 2) - x[2]));
+    if (d < d1) {
+      f2 = f1;
+      d2 = d1;
+      f1 = f;
+      d1 = d;
+    } else if (d < d2) {
+      f2 = f;
+      d2 = d;
+    }
+  }
+  if (f2 < 0 || d1 < 1e-12) return pb(f1 - nIn);
+  return (pb(f1 - nIn) / d1 + pb(f2 - nIn) / d2) / (1 / d1 + 1 / d2);
 }
 
 }  // namespace mfsi::fluid

@@ -35,4 +35,8 @@ PatchLoads patchLoads(const FluidSolver& fluid, const std::string& name, const V
 /// pNet times the baffle normal (pointing from the master side to the slave side).
 void baffleNetPressure(const FluidSolver& fluid, const std::string& baffle, const RealView& pNet);
 
+/// \brief Pressure at point `x` on patch `patch`: the boundary values of the two faces whose
+/// centroids are nearest, blended by inverse distance (the value of a face whose centroid is at `x`).
+real boundaryPressureAt(const FluidSolver& fluid, const std::string& patch, const Vec3& x);
+
 }  // namespace mfsi::fluid

@@ -14,30 +14,12 @@ using namespace mfsi::fluid;
 
 namespace {
 
-// Pressure at a point on the cylinder surface: the two boundary faces whose centroids are nearest,
-// blended by inverse distance (the boundary values are extrapolated from the wall cells).
+// Pressure at a point (x, y) on the cylinder surface, in the mid-plane of the one-cell-thick mesh.
 double surfacePressure(const FluidSolver& fluid, double x, double y) {
   const HexMesh& mesh = fluid.mesh();
   const auto& cyl = mesh.patches()[mesh.patchIndex("cylinder")];
   auto fc = Kokkos::create_mirror_view_and_copy(HostSpace(), fluid.geometry().faceCentroid);
-  auto pb = Kokkos::create_mirror_view_and_copy(HostSpace(), fluid.boundaryPressure());
-  int f1 = -1, f2 = -1;
-  double d1 = 1e300, d2 = 1e300;
-  for (int f = cyl.start; f < cyl.start + cyl.size; ++f) {
-    const double d = std::hypot(fc(f, 0) - x, fc(f, 1) - y);
-    if (d < d1) {
-      f2 = f1;
-      d2 = d1;
-      f1 = f;
-      d1 = d;
-    } else if (d < d2) {
-      f2 = f;
-      d2 = d;
-    }
-  }
-  const int nIn = mesh.nInternalFaces();
-  if (d1 < 1e-12) return pb(f1 - nIn);
-  return (pb(f1 - nIn) / d1 + pb(f2 - nIn) / d2) / (1 / d1 + 1 / d2);
+  return boundaryPressureAt(fluid, "cylinder", {x, y, fc(cyl.start, 2)});
 }
 
 }  // namespace
