@@ -24,6 +24,20 @@ using gid_t = std::int64_t;
 
 using RandomRead = Kokkos::MemoryTraits<Kokkos::RandomAccess>;
 
+/// Whether kernels run where the host can read their data (OpenMP, Serial, Threads): host-only
+/// kernel variants (loops over runs of rows that the compiler vectorises) are chosen on this.
+constexpr bool kHostExec = Kokkos::SpaceAccessibility<ExecSpace, HostSpace>::accessible;
+
+/// Before a host loop whose iterations are independent although it writes through pointers the
+/// compiler cannot prove distinct from the ones it reads: lets the loop vectorise.
+#if defined(__clang__)
+#define MFSI_IVDEP _Pragma("clang loop vectorize(assume_safety)")
+#elif defined(__GNUC__)
+#define MFSI_IVDEP _Pragma("GCC ivdep")
+#else
+#define MFSI_IVDEP
+#endif
+
 // Device views.
 using RealView = Kokkos::View<real*, MemSpace>;
 using Real3View = Kokkos::View<real* [3], MemSpace>;

@@ -1,5 +1,7 @@
 #include "fluid/FvAssembly.hpp"
 
+#include "kernels/CsrBuild.hpp"
+
 #include <algorithm>
 #include <vector>
 
@@ -47,6 +49,7 @@ FvSparsity buildSparsity(const HexMesh& mesh) {
 
   FvSparsity s;
   s.nRows = nCells;
+  s.runs = buildRowRuns(nCells, rowPtr, cols, "mfsi::fluid::fv");
   s.rowPtr = IndexView("mfsi::fluid::fv::rowPtr", nCells + 1);
   s.colIdx = IndexView("mfsi::fluid::fv::colIdx", cols.size());
   s.diagIdx = IndexView("mfsi::fluid::fv::diagIdx", nCells);
@@ -88,6 +91,7 @@ CsrMatrix makeMatrix(const FvSparsity& s, const std::string& label) {
   A.rowPtr = s.rowPtr;
   A.colIdx = s.colIdx;
   A.diagIdx = s.diagIdx;
+  A.runs = s.runs;
   A.values = RealView(label, s.colIdx.extent(0));
   return A;
 }

@@ -38,6 +38,7 @@ struct FvSparsity {
                           ///< cell's row, -1 for boundary faces
   IndexView ownerPos;     ///< per internal face: position of (owner, neighbour)
   IndexView neighbourPos; ///< per internal face: position of (neighbour, owner)
+  CsrRowRuns runs;        ///< row runs of the sparsity (kernels/CsrMatrix.hpp)
 };
 
 /// \brief Build the sparsity of `mesh` (host-side build, copied to the device; once per topology).

@@ -357,6 +357,11 @@ constexpr int kEllWidths[] = {4, 6, 8};
 constexpr double kEllMaxPadding = 3.0;
 /// Most distinct column patterns of a pattern-compressed ELL operator (one-byte ids).
 constexpr std::size_t kMaxPatterns = 256;
+/// Longest run of a pattern-compressed operator: bounds a host thread's unit of work.
+constexpr lid_t kMaxRun = 1024;
+/// Host backends sweep pattern-compressed operators run by run (vectorisable); device backends
+/// row by row (one thread per row, coalesced).
+constexpr bool kRunSweeps = kHostExec;
 
 template <class S>
 using WorkView = Kokkos::View<S*, MemSpace>;
@@ -384,8 +389,16 @@ struct AmgCycleOp {
   IndexView col;     ///< empty when the columns are given by patterns
   /// ELL with few distinct column patterns (a structured block: one per boundary type): row i's
   /// columns are i + offsets(pattern(i) * width + k). 1 byte per row instead of 4 per entry.
+  /// Pattern-compressed values are stored by column, val(k * nRows + i): contiguous in i for the
+  /// vectorised host sweeps and coalesced on GPUs.
   Kokkos::View<std::uint8_t*, MemSpace> pattern;
   IndexView offsets;
+  /// Pattern-compressed operators only: maximal runs of consecutive rows with one pattern (rows
+  /// [runStart(r), runStart(r + 1)) have pattern runPattern(r)), cut at kMaxRun rows. Host
+  /// backends sweep a run with the pattern's offsets in registers: contiguous, vectorisable loads.
+  IndexView runStart;
+  Kokkos::View<std::uint8_t*, MemSpace> runPattern;
+  lid_t nRuns = 0;
   IndexView src;
   Kokkos::View<S*, MemSpace> val;
 };
@@ -485,6 +498,26 @@ detail::AmgCycleOp<S> buildCycleOp(const CsrMatrix& M, bool dropDiagonal, const 
                             rowPattern.data(), rowPattern.size()));
       op.offsets = upload(offsets, label + "::offsets");
       col.clear();
+      // Values by column (see AmgCycleOp): src follows.
+      std::vector<lid_t> byColumn(src.size());
+      for (lid_t i = 0; i < n; ++i)
+        for (int k = 0; k < op.width; ++k)
+          byColumn[static_cast<std::size_t>(k) * n + i] = src[static_cast<std::size_t>(i) * op.width + k];
+      src.swap(byColumn);
+      std::vector<lid_t> runStart{0};
+      std::vector<std::uint8_t> runPattern;
+      for (lid_t i = 1; i <= n; ++i)
+        if (i == n || rowPattern[i] != rowPattern[i - 1] || i - runStart.back() == kMaxRun) {
+          runPattern.push_back(rowPattern[runStart.back()]);
+          runStart.push_back(i);
+        }
+      op.nRuns = static_cast<lid_t>(runPattern.size());
+      op.runStart = upload(runStart, label + "::runStart");
+      op.runPattern = Kokkos::View<std::uint8_t*, MemSpace>(
+          Kokkos::view_alloc(Kokkos::WithoutInitializing, label + "::runPattern"), runPattern.size());
+      Kokkos::deep_copy(op.runPattern,
+                        Kokkos::View<const std::uint8_t*, HostSpace, Kokkos::MemoryTraits<Kokkos::Unmanaged>>(
+                            runPattern.data(), runPattern.size()));
     }
   }
   if (!col.empty()) op.col = upload(col, label + "::col");
@@ -507,19 +540,21 @@ void refreshCycleOp(const ExecSpace& exec, const detail::AmgCycleOp<S>& op, cons
   const ConstIndexView di = colDiagOf ? ConstIndexView(colDiagOf->diagIdx) : ConstIndexView();
   const WorkView<S> val = op.val;
   const int w = op.width;
+  const lid_t n = op.nRows;
   const bool hasSrc = src.extent(0) > 0, hasRow = rowScale.extent(0) > 0, hasCol = colDiagOf != nullptr;
   Kokkos::parallel_for(
       "mfsi::kernels::amg::cycleValues", RangePolicy(exec, 0, op.nRows), KOKKOS_LAMBDA(lid_t i) {
         const lid_t k0 = w > 0 ? i * w : ptr(i), k1 = w > 0 ? k0 + w : ptr(i + 1);
         const double rs = hasRow ? rowScale(i) : 1.0;
         for (lid_t k = k0; k < k1; ++k) {
-          const lid_t s = hasSrc ? src(k) : k;
+          const lid_t e = patterned ? (k - k0) * n + i : k;  // patterned values are stored by column
+          const lid_t s = hasSrc ? src(e) : e;
           double v = 0.0;
           if (s >= 0) {
             v = rs * mv(s);
             if (hasCol) v *= dv(di(patterned ? i + offsets(pattern(i) * w + (k - k0)) : col(k)));
           }
-          val(k) = static_cast<S>(v);
+          val(e) = static_cast<S>(v);
         }
       });
 }
@@ -544,15 +579,16 @@ struct OpRows {
   ConstIndexView rowPtr, col, offsets;
   Kokkos::View<const std::uint8_t*, MemSpace, RandomRead> pattern;
   ReadView<S> val;
+  lid_t n;
   explicit OpRows(const detail::AmgCycleOp<S>& op)
-      : rowPtr(op.rowPtr), col(op.col), offsets(op.offsets), pattern(op.pattern), val(op.val) {}
+      : rowPtr(op.rowPtr), col(op.col), offsets(op.offsets), pattern(op.pattern), val(op.val), n(op.nRows) {}
   template <class X>
   KOKKOS_FORCEINLINE_FUNCTION S sum(lid_t i, const X& x) const {
     constexpr int W = L::width;
     S s = 0;
     if constexpr (W > 0 && L::patterned) {
-      const lid_t o = i * W, p = pattern(i) * W;
-      for (int k = 0; k < W; ++k) s += val(o + k) * x(i + offsets(p + k));
+      const lid_t p = pattern(i) * W;
+      for (int k = 0; k < W; ++k) s += val(k * n + i) * x(i + offsets(p + k));
     } else if constexpr (W > 0) {
       const lid_t o = i * W;
       for (int k = 0; k < W; ++k) s += val(o + k) * x(col(o + k));
@@ -578,6 +614,81 @@ void byLayout(const detail::AmgCycleOp<S>& op, const F& f) {
       return f(Layout<0, false>());
   }
 }
+
+/// Host sweeps of a pattern-compressed operator, run by run: within a run the pattern's W offsets
+/// and value columns are loop invariants, so row i's terms are contiguous loads at i + offset and
+/// the loop over rows vectorises (a row-by-row kernel reloads the offsets through the row's
+/// pattern id: an indirect load per term, which the compiler cannot vectorise). Same sums in the
+/// same order as OpRows::sum: results are bitwise those of the row kernels.
+template <class S, int W>
+struct RunRows {
+  const lid_t* runStart;
+  const std::uint8_t* runPattern;
+  const lid_t* offsets;
+  const S* val;
+  lid_t n;
+  explicit RunRows(const detail::AmgCycleOp<S>& op)
+      : runStart(op.runStart.data()),
+        runPattern(op.runPattern.data()),
+        offsets(op.offsets.data()),
+        val(op.val.data()),
+        n(op.nRows) {}
+  /// Calls row(i, s) for every row i of run r, with s = sum_k op(i, k) x(i + offset_k).
+  template <class Row>
+  void forRows(lid_t r, const S* x, const Row& row) const {
+    const lid_t i0 = runStart[r], i1 = runStart[r + 1];
+    const lid_t* o = offsets + static_cast<lid_t>(runPattern[r]) * W;
+    const S* xk[W];
+    const S* vk[W];
+    for (int k = 0; k < W; ++k) {
+      xk[k] = x + o[k];
+      vk[k] = val + static_cast<std::size_t>(k) * n;
+    }
+    MFSI_IVDEP
+    for (lid_t i = i0; i < i1; ++i) {
+      S s = 0;
+      for (int k = 0; k < W; ++k) s += vk[k][i] * xk[k][i];
+      row(i, s);
+    }
+  }
+};
+
+/// SmootherStepKernel over runs (host backends).
+template <class S, int W, class T, bool ReadD, bool WriteD>
+struct SmootherRunKernel {
+  RunRows<S, W> A;
+  const S* bh;
+  const S* xIn;
+  const S* dIn;
+  T* xOut;
+  S* dOut;
+  S c1, c2;
+  void operator()(lid_t r) const {
+    A.forRows(r, xIn, [&](lid_t i, S s) {
+      const S xi = xIn[i];
+      const S ri = bh[i] - xi - s;
+      S di;
+      if constexpr (ReadD)
+        di = c1 * dIn[i] + c2 * ri;
+      else
+        di = c2 * ri;
+      xOut[i] = xi + di;
+      if constexpr (WriteD) dOut[i] = di;
+    });
+  }
+};
+
+/// ResidualKernel over runs (host backends).
+template <class S, int W>
+struct ResidualRunKernel {
+  RunRows<S, W> A;
+  const S* bh;
+  const S* x;
+  S* r;
+  void operator()(lid_t run) const {
+    A.forRows(run, x, [&](lid_t i, S s) { r[i] = bh[i] - x[i] - s; });
+  }
+};
 
 /// Finest level, from a zero guess: bh = D^{-1} b (b is apply()'s double input) and the first
 /// smoother step x = c bh (no SpMV).
@@ -980,6 +1091,27 @@ WorkView<S> runSteps(const ExecSpace& exec, const detail::AmgCycleLevel<S>& C, c
     const WorkView<S> next = cur.data() == C.x.data() ? C.y : C.x;
     byLayout(C.A, [&](auto layout) {
       using L = decltype(layout);
+      if constexpr (L::patterned && kRunSweeps) {
+        const RangePolicy runs(exec, 0, C.A.nRuns);
+        auto sweep = [&](auto* xOut, auto readTag, auto writeTag) {
+          using T = std::remove_pointer_t<decltype(xOut)>;
+          Kokkos::parallel_for("mfsi::kernels::amg::smoother", runs,
+                               SmootherRunKernel<S, L::width, T, decltype(readTag)::value, decltype(writeTag)::value>{
+                                   RunRows<S, L::width>(C.A), C.b.data(), cur.data(), dIn.data(), xOut,
+                                   dOut.data(), c1, c2});
+        };
+        auto dispatch = [&](auto* xOut) {
+          if (readD && writeD) return sweep(xOut, std::true_type(), std::true_type());
+          if (readD) return sweep(xOut, std::true_type(), std::false_type());
+          if (writeD) return sweep(xOut, std::false_type(), std::true_type());
+          return sweep(xOut, std::false_type(), std::false_type());
+        };
+        if (last && toOut)
+          dispatch(out.data());
+        else
+          dispatch(next.data());
+        return;
+      }
       const RangePolicy policy(exec, 0, C.A.nRows);
       if (last && toOut)
         Kokkos::parallel_for(
@@ -1013,8 +1145,12 @@ void vcycle(const ExecSpace& exec, const detail::AmgHierarchy& h, const std::vec
   const WorkView<S> x = runSteps<S>(exec, C, L.steps, 1, C.x, C.x, out, false);
   byLayout(C.A, [&](auto layout) {
     using L = decltype(layout);
-    Kokkos::parallel_for("mfsi::kernels::amg::residual", RangePolicy(exec, 0, C.A.nRows),
-                         ResidualKernel<S, L>{OpRows<S, L>(C.A), C.b, x, C.r});
+    if constexpr (L::patterned && kRunSweeps)
+      Kokkos::parallel_for("mfsi::kernels::amg::residual", RangePolicy(exec, 0, C.A.nRuns),
+                           ResidualRunKernel<S, L::width>{RunRows<S, L::width>(C.A), C.b.data(), x.data(), C.r.data()});
+    else
+      Kokkos::parallel_for("mfsi::kernels::amg::residual", RangePolicy(exec, 0, C.A.nRows),
+                           ResidualKernel<S, L>{OpRows<S, L>(C.A), C.b, x, C.r});
   });
   const auto& N = cycle[l + 1];
   const bool nextDirect = !scaledRhs(h, l + 1);

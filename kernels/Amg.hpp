@@ -29,7 +29,8 @@
 /// preconditioner far below what CG notices: the iteration counts are those of the double cycle.
 ///
 /// Measured (tests/kernels/test_amg.cpp, 7-point Dirichlet Poisson, rough right-hand side, CG to
-/// 1e-8): 9 iterations at 16^3, 24^3 and 32^3 (Jacobi-CG: 59, 86, 116); operator complexity 1.5.
+/// 1e-8): 7 / 7 / 8 iterations at 16^3, 24^3 and 32^3 with the default degree-3 Chebyshev
+/// smoother (degree 2: 9 / 9 / 9; Jacobi-CG: 59, 86, 116); operator complexity 1.5.
 /// perf/bench_linsolve PressureSolve (same problem): 9 / 10 / 12 iterations at 32^3 / 64^3 /
 /// 128^3 in both precisions; per CG iteration, mixed-precision cycle vs the double CSR cycle it
 /// replaced (medians, one run each, shared 2-core machine): 64^3 11.3 vs 18.0 ms on one thread,
@@ -73,7 +74,11 @@ struct AmgOptions {
   AmgProlongation prolongation = AmgProlongation::Smoothed;
   AmgSmoother smoother = AmgSmoother::Chebyshev;
   int sweeps = 1;           ///< smoother applications before and after the coarse correction
-  int chebyshevDegree = 2;  ///< polynomial degree (SpMVs per Chebyshev application)
+  /// Polynomial degree (SpMVs per Chebyshev application). 3 measured best on the 3D cavity at
+  /// 64^3 (perf/bench_cavity3d): AMG-CG iterations per step 11.5 / 9.4 / 8.6 / 8.2 for degree
+  /// 2 / 3 / 4 / 5, and the least time per step at 3 (~7 % less than 2; 4 and 5 cost more per
+  /// iteration than they save).
+  int chebyshevDegree = 3;
   /// Chebyshev damps the spectrum of D^{-1}A in [lambda_max / ratio, lambda_max]. The coarse
   /// level handles the rest; ~ the coarsening ratio (8-30 here) is the usual choice, 10 measured
   /// best on the 3D Poisson equation (11 vs 16 CG iterations with 30 at 64^3).

@@ -10,6 +10,21 @@ void spmv(const ExecSpace& exec, const CsrMatrix& A, const ConstRealView& x, con
 }
 
 void spmv(const ExecSpace& exec, real alpha, const CsrMatrix& A, const ConstRealView& x, real beta, const RealView& y) {
+  if (detail::useRuns(A)) {
+    const detail::RunView R(A);
+    const double* xp = x.data();
+    double* yp = y.data();
+    exec.fence();
+    Kokkos::parallel_for("mfsi::kernels::blas::spmv", detail::hostPolicy(exec, 0, A.runs.count), [=](lid_t r) {
+      detail::forRunRows(R, r, [&](lid_t i, const double* v, const lid_t* off, auto width) {
+        double s = 0.0;
+        for (int k = 0; k < width; ++k) s += v[k] * xp[i + off[k]];
+        yp[i] = beta == 0.0 ? alpha * s : alpha * s + beta * yp[i];
+      });
+    });
+    HostExecSpace().fence();
+    return;
+  }
   const ConstIndexView rowPtr = A.rowPtr, colIdx = A.colIdx;
   const ConstRealView val = A.values;
   Kokkos::parallel_for(
@@ -22,6 +37,22 @@ void spmv(const ExecSpace& exec, real alpha, const CsrMatrix& A, const ConstReal
 
 double spmvDot(const ExecSpace& exec, const SolverComm& comm, const CsrMatrix& A, const ConstRealView& x,
                const RealView& y, const ConstRealView& w) {
+  if (detail::useRuns(A)) {
+    const detail::RunView R(A);
+    const double* xp = x.data();
+    const double* wp = w.data();
+    double* yp = y.data();
+    return detail::reduceRuns<1>(
+        exec, comm, "mfsi::kernels::blas::spmvDot", A,
+        [=](lid_t r) {
+          detail::forRunRows(R, r, [&](lid_t i, const double* v, const lid_t* off, auto width) {
+            double ax = 0.0;
+            for (int k = 0; k < width; ++k) ax += v[k] * xp[i + off[k]];
+            yp[i] = ax;
+          });
+        },
+        [=](lid_t i, Sums<1>& s) { s[0] += wp[i] * yp[i]; })[0];
+  }
   const ConstIndexView rowPtr = A.rowPtr, colIdx = A.colIdx;
   const ConstRealView val = A.values;
   return reduce<1>(

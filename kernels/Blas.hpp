@@ -15,7 +15,10 @@
 #include "kernels/CsrMatrix.hpp"
 
 #include <array>
+#include <cstddef>
 #include <string>
+#include <type_traits>
+#include <vector>
 
 namespace mfsi {
 
@@ -51,7 +54,7 @@ class SolverComm {
 namespace blas {
 
 /// \brief Rows per block of a deterministic reduction (see the file comment).
-inline constexpr lid_t kReductionBlock = 256;
+inline constexpr lid_t kReductionBlock = kRowBlock;
 
 /// \brief N running sums carried through a fused reduction body.
 template <int N>
@@ -90,6 +93,90 @@ std::array<double, N> reduce(const ExecSpace& exec, const SolverComm& comm, cons
   comm.globalSum(out.data(), N);
   return out;
 }
+
+// ---------------------------------------------------------------------------------------------
+// Host sweeps over the row runs of a matrix (CsrRowRuns): within a run the column offsets are loop
+// invariants and every row has the same length, so the loads of x are at i + offset (contiguous)
+// and no column index is read. Each row sums its terms in column order, as the row kernels do,
+// and reduceRuns adds the per-row contributions row by row in block order, as `reduce` does: the
+// results are bitwise those of the row kernels. Used only where kHostExec (host backends); device
+// backends keep the row kernels.
+// ---------------------------------------------------------------------------------------------
+namespace detail {
+
+/// Host range policy on `exec` where it is a host instance (never launched on device builds).
+template <class E>
+Kokkos::RangePolicy<HostExecSpace> hostPolicy(const E& exec, lid_t begin, lid_t end) {
+  if constexpr (std::is_same<E, HostExecSpace>::value)
+    return Kokkos::RangePolicy<HostExecSpace>(exec, begin, end);
+  else
+    return Kokkos::RangePolicy<HostExecSpace>(begin, end);
+}
+
+/// Host pointers to a matrix's runs and values.
+struct RunView {
+  const lid_t* start = nullptr;
+  const lid_t* offsetsAt = nullptr;
+  const lid_t* offsets = nullptr;
+  const lid_t* rowPtr = nullptr;
+  const double* val = nullptr;
+  RunView() = default;
+  explicit RunView(const CsrMatrix& A)
+      : start(A.runs.start.data()),
+        offsetsAt(A.runs.offsetsAt.data()),
+        offsets(A.runs.offsets.data()),
+        rowPtr(A.rowPtr.data()),
+        val(A.values.data()) {}
+};
+
+/// Calls row(i, v, off, w) for every row i of run r: v points at row i's w values, whose columns
+/// are i + off[k]. w is std::integral_constant<int, 7> for 7-entry rows (the interior of a hex
+/// block; the loop over k unrolls) and an int otherwise.
+template <class Row>
+inline void forRunRows(const RunView& R, lid_t r, const Row& row) {
+  const lid_t i0 = R.start[r], i1 = R.start[r + 1];
+  const lid_t w = R.rowPtr[i0 + 1] - R.rowPtr[i0];
+  const lid_t* off = R.offsets + R.offsetsAt[r];
+  const double* v = R.val + R.rowPtr[i0] - static_cast<std::ptrdiff_t>(i0) * w;
+  if (w == 7) {
+    MFSI_IVDEP
+    for (lid_t i = i0; i < i1; ++i) row(i, v + static_cast<std::ptrdiff_t>(i) * 7, off, std::integral_constant<int, 7>());
+  } else {
+    for (lid_t i = i0; i < i1; ++i) row(i, v + static_cast<std::ptrdiff_t>(i) * w, off, static_cast<int>(w));
+  }
+}
+
+/// `reduce` over a matrix's runs: per block of kRowBlock rows, runBody(r) for the block's runs in
+/// order (writing per-row results), then rowSum(i, sums) for its rows in order.
+template <int N, class RunBody, class RowSum>
+std::array<double, N> reduceRuns(const ExecSpace& exec, const SolverComm& comm, const std::string& label,
+                                 const CsrMatrix& A, const RunBody& runBody, const RowSum& rowSum) {
+  const lid_t n = A.nRows, bs = kRowBlock;
+  const lid_t nBlocks = (n + bs - 1) / bs;
+  std::vector<double> partial(static_cast<std::size_t>(nBlocks) * N);
+  double* part = partial.data();
+  const lid_t* blockStart = A.runs.blockStart.data();
+  exec.fence();
+  Kokkos::parallel_for(label, hostPolicy(exec, 0, nBlocks), [=](lid_t blk) {
+    for (lid_t r = blockStart[blk]; r < blockStart[blk + 1]; ++r) runBody(r);
+    Sums<N> s;
+    for (int k = 0; k < N; ++k) s[k] = 0.0;
+    const lid_t end = (blk + 1) * bs < n ? (blk + 1) * bs : n;
+    for (lid_t i = blk * bs; i < end; ++i) rowSum(i, s);
+    for (int k = 0; k < N; ++k) part[static_cast<std::size_t>(blk) * N + k] = s[k];
+  });
+  HostExecSpace().fence();
+  std::array<double, N> out{};
+  for (lid_t b = 0; b < nBlocks; ++b)
+    for (int k = 0; k < N; ++k) out[k] += part[static_cast<std::size_t>(b) * N + k];
+  comm.globalSum(out.data(), N);
+  return out;
+}
+
+/// Whether A's kernels take the run path.
+inline bool useRuns(const CsrMatrix& A) { return kHostExec && A.runs.count > 0; }
+
+}  // namespace detail
 
 /// \brief y = A x (rows [0, A.nRows); x has A.nCols entries).
 void spmv(const ExecSpace& exec, const CsrMatrix& A, const ConstRealView& x, const RealView& y);

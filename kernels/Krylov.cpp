@@ -139,6 +139,26 @@ KOKKOS_INLINE_FUNCTION void jacobiRow3(const ConstIndexView& rowPtr, const Const
   }
 }
 
+/// jacobiRow3 for the rows of run `run` (host backends, see blas::detail::forRunRows): y = A (inv .* x)
+/// for the three columns of the row-major n x 3 arrays x and y, each sum in jacobiRow3's order.
+inline void jacobiRun3(const blas::detail::RunView& R, lid_t run, const double* inv, const double* x, double* y) {
+  static_assert(!kHostExec || std::is_same<Real3View::array_layout, Kokkos::LayoutRight>::value,
+                "host n x 3 views are row-major");
+  blas::detail::forRunRows(R, run, [&](lid_t i, const double* v, const lid_t* off, auto width) {
+    double s0 = 0.0, s1 = 0.0, s2 = 0.0;
+    for (int k = 0; k < width; ++k) {
+      const lid_t j = i + off[k];
+      const double a = v[k], d = inv[j];
+      s0 += a * (d * x[3 * j]);
+      s1 += a * (d * x[3 * j + 1]);
+      s2 += a * (d * x[3 * j + 2]);
+    }
+    y[3 * i] = s0;
+    y[3 * i + 1] = s1;
+    y[3 * i + 2] = s2;
+  });
+}
+
 }  // namespace
 
 // ---------------------------------------------------------------------------------------------
@@ -419,6 +439,8 @@ std::array<KrylovResult, 3> BiCGStab3::run(const ExecSpace& exec, const CsrMatri
   const ConstRealView inv = invDiag;
   const ConstIndexView rowPtr = A.rowPtr, colIdx = A.colIdx;
   const ConstRealView val = A.values;
+  const blas::detail::RunView R = blas::detail::useRuns(A) ? blas::detail::RunView(A) : blas::detail::RunView{};
+  const double* invp = inv.data();
 
   // Start: residuals and their norms, stopping tests.
   std::array<double, 3> rr{}, l1{};
@@ -506,7 +528,14 @@ std::array<KrylovResult, 3> BiCGStab3::run(const ExecSpace& exec, const CsrMatri
     // K2: v = A phat with phat_j = inv_j p_j formed in the gather (A and inv read once for the
     // three columns), and rhat.v.
     comm_.updateGhosts(exec, p);
-    const auto rv = reduce<3>(
+    const auto rv = blas::detail::useRuns(A)
+        ? blas::detail::reduceRuns<3>(
+              exec, comm_, "mfsi::kernels::krylov::bicgstab3::v", A,
+              [=](lid_t run) { jacobiRun3(R, run, invp, p.data(), v.data()); },
+              [=](lid_t i, Sums<3>& acc) {
+                for (int c = 0; c < 3; ++c) acc[c] += rhat(i, c) * v(i, c);
+              })
+        : reduce<3>(
         exec, comm_, "mfsi::kernels::krylov::bicgstab3::v", n, KOKKOS_LAMBDA(lid_t i, Sums<3> & acc) {
           double av[3];
           jacobiRow3(rowPtr, colIdx, val, inv, p, i, av);
@@ -568,7 +597,17 @@ std::array<KrylovResult, 3> BiCGStab3::run(const ExecSpace& exec, const CsrMatri
     for (int c = 0; c < 3; ++c) w[c] = 0.0;
     if (anyFull) {
       comm_.updateGhosts(exec, r);
-      const auto ts = reduce<6>(
+      const auto ts = blas::detail::useRuns(A)
+          ? blas::detail::reduceRuns<6>(
+                exec, comm_, "mfsi::kernels::krylov::bicgstab3::t", A,
+                [=](lid_t run) { jacobiRun3(R, run, invp, r.data(), t.data()); },
+                [=](lid_t i, Sums<6>& acc) {
+                  for (int c = 0; c < 3; ++c) {
+                    acc[c] += t(i, c) * r(i, c);
+                    acc[3 + c] += t(i, c) * t(i, c);
+                  }
+                })
+          : reduce<6>(
           exec, comm_, "mfsi::kernels::krylov::bicgstab3::t", n, KOKKOS_LAMBDA(lid_t i, Sums<6> & acc) {
             double at[3];
             jacobiRow3(rowPtr, colIdx, val, inv, r, i, at);
