@@ -165,7 +165,11 @@ Schema fluidSchema() {
                                     .atMost(1),
                Default(d.pimple.relaxPressure))
           .key("ddtCorrection", Schema::boolean("Rhie-Chow correction of the time-derivative term"),
-               Default(d.pimple.ddtCorrection));
+               Default(d.pimple.ddtCorrection))
+          .key("extrapolateGuess",
+               Schema::boolean("start the first momentum solve of a step from U extrapolated in time, and the final "
+                               "pressure solve from the last step's final-corrector change (initial guesses only)"),
+               Default(d.pimple.extrapolateGuess));
   Schema pressure = linearSolverSchema("pressure", d.pressureSolver.tolerance, d.pressureSolver.maxIter);
   pressure.key("finalRelTol", Schema::real("relTol of the last pressure solve of a step (pFinal; < 0: relTol)", "-").lessThan(1),
                Default(d.pressureFinalRelTol))
@@ -246,6 +250,7 @@ FluidOptions readFluidOptions(const SceneConfig& c, const HexMesh& mesh) {
   o.pimple.relaxVelocity = c.get<double>("pimple.relaxVelocity");
   o.pimple.relaxPressure = c.get<double>("pimple.relaxPressure");
   o.pimple.ddtCorrection = c.get<bool>("pimple.ddtCorrection");
+  o.pimple.extrapolateGuess = c.get<bool>("pimple.extrapolateGuess");
 
   auto solver = [&](const std::string& k) {
     return LinearSolverOptions{c.get<double>(k + ".tolerance"), c.get<double>(k + ".relTol"), c.get<int>(k + ".maxIter")};

@@ -37,6 +37,9 @@
 
 namespace mfsi::fluid {
 
+/// Device functor of the phiHbyA face formula (FluidSolver.cpp).
+struct PhiHbyAFace;
+
 /// \brief What one call of `solve()` did.
 struct StepResult {
   bool ok = true;          ///< false on NaN/Inf or a linear-solver breakdown
@@ -126,17 +129,34 @@ class FluidSolver {
   void computeVelocityGradient() const;
   void pressureGradient(const ConstIndexView& cells);
   void updatePressureGradient();
-  void assembleMomentum();
-  void assembleMomentumFused();
-  void computeHbyA();
+  bool assembleMomentum(bool withB);
+  void assembleMomentumFused(bool withB);
+  void computeHbyA(bool withRAU);
+  /// The phiHbyA face formula with this step's fields and coefficients (device functor).
+  PhiHbyAFace phiHbyAFace() const;
+  /// U = U0 + (dt / dt0) (U0 - U00): the first momentum solve's initial guess (extrapolateGuess).
+  void extrapolateVelocity();
+  /// Whether U00_ is kept for the extrapolated initial guess of the momentum solve.
+  bool extrapolatesVelocity() const;
+  /// extrapolateGuess around the final pressure solve: remember p, add dpFinal_; then store the
+  /// change the solve made (measured from p without the guess).
+  void startFinalPressureSolve();
+  void finishFinalPressureSolve();
   void computePhiHbyA();
   void assemblePressureMatrix();
+  void assemblePressureMatrixFused();
+  void assemblePressureMatrixFaces();
   void assemblePressureSource();
+  bool fusedPressureSource() const;
+  void pressureSourceFlux();
+  void pressureSourceFluxFaces();
+  void finishPressureSource();
   bool pinsPressureLevel() const;
   void correctFluxAndVelocity();
   bool compressible() const;
   void storeDdtCorrection();
   real continuityMax(real& sum);
+  real finishStep(real& sum, bool& finite);
   bool fieldsFinite();
 
   const HexMesh& mesh_;
@@ -148,7 +168,7 @@ class FluidSolver {
   FvFaceData fd_;
   FvSparsity sparsity_;
   CsrMatrix Au_, Ap_;
-  FaceCoefficients fcU_, fcP_;
+  FaceCoefficients fcU_, fcP_;  ///< allocated on first use (the fused paths do not need them)
   BoundaryConditions bc_;
   LinearSolver linear_;
 
@@ -162,7 +182,7 @@ class FluidSolver {
   Real3View b3_;
   // Face fields.
   RealView phi_, meshPhi_, phiHbyA_, dphi_, dphi0_, dphi00_, sweptNew_, sweptOld_, fluxP_;
-  Real3View fluxU_;
+  Real3View fluxU_;  ///< like phiHbyA_, allocated by the face path that needs it
   // Boundary-face fields.
   Real3View Ub_, faceMeshVel_;
   RealView pb_;
@@ -188,6 +208,25 @@ class FluidSolver {
   /// velocity gradient they need, are live. False on Cartesian meshes, where they vanish exactly.
   bool nonOrthogonal_ = true;
   bool hasResistance_ = false;
+  /// sweptNew_ / sweptOld_ are all zero (no moveMesh in this step / the previous one), so the mesh
+  /// flux is exactly zero and need not be read.
+  bool sweptNewZero_ = true, sweptOldZero_ = true, meshStatic_ = true;
+  /// moveMesh was called since beginStep last copied the positions and volumes (V0_, points0_).
+  bool meshMoved_ = false;
+  /// extrapolateGuess: no solve() since beginStep yet (the first one extrapolates U); the change
+  /// the last final pressure solve made (dpFinal_, valid once one ran), and p at its start.
+  bool freshStep_ = false;
+  bool dpFinalValid_ = false;
+  RealView dpFinal_, pFinalStart_;
+  /// meshPhi_ is all zeros (static mesh or steady), so computeMeshFlux need not rewrite it.
+  bool meshFluxZero_ = true;
+  /// dphi_ holds the latest correction fluxes (written by solve() or setVelocity since the last
+  /// beginStep); otherwise they are in dphi0_ and dphi_ is scratch.
+  bool dphiLatest_ = true;
+  /// Some boundary face takes its velocity from its cell (slip, empty, pressure): the boundary
+  /// velocities must follow every change of U. With walls and inlets alone they depend on the
+  /// prescribed values only.
+  bool boundaryVelocityReadsU_ = true;
   /// gradU_ is what velocityGradient() promises (see there); false when the outer loop skipped it.
   mutable bool gradUCurrent_ = false;  ///< a resistance outlet changes the boundary pressure every corrector
   real c1_ = 0, c0_ = 0, c00_ = 0;  ///< time weights: d(phi)/dt ~ (c1 phi - c0 phi0 + c00 phi00)/dt
