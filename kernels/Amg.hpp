@@ -31,12 +31,11 @@
 /// Measured (tests/kernels/test_amg.cpp, 7-point Dirichlet Poisson, rough right-hand side, CG to
 /// 1e-8): 7 / 7 / 8 iterations at 16^3, 24^3 and 32^3 with the default degree-3 Chebyshev
 /// smoother (degree 2: 9 / 9 / 9; Jacobi-CG: 59, 86, 116); operator complexity 1.5.
-/// perf/bench_linsolve PressureSolve (same problem): 9 / 10 / 12 iterations at 32^3 / 64^3 /
-/// 128^3 in both precisions; per CG iteration, mixed-precision cycle vs the double CSR cycle it
-/// replaced (medians, one run each, shared 2-core machine): 64^3 11.3 vs 18.0 ms on one thread,
-/// 5.9 vs 9.3 ms on two; 128^3 99 vs 152 ms on one thread, 51 vs 78 ms on two (1.5-1.6x). The
-/// double cycle with the same layouts: 1.06-1.17x. At 32^3 (cache-resident) the kernels are bound
-/// by instructions, not bytes, and float gains little (1.0-1.2x).
+/// perf/bench_linsolve PressureSolve (same problem): 8 / 9 / 10 iterations at 32^3 / 64^3 /
+/// 128^3 in both precisions (degree 2: 9 / 10 / 12). Per CG iteration on one thread, float cycle
+/// vs double cycle: 64^3 11.5 vs 17.1 ms, 128^3 97 vs 133 ms (perf/RESULTS.md); the degree-2
+/// double CSR cycle the float cycle replaced took 18.0 / 152 ms. At 32^3 (cache-resident) the
+/// kernels are bound by instructions, not bytes, and float gains little (1.1-1.2x).
 ///
 /// Singular (pure Neumann) systems: aggregation keeps the constant vector in the range of every P,
 /// so every coarse operator has the same null space, and the coarsest solve is a pseudo-inverse
