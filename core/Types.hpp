@@ -30,7 +30,9 @@ constexpr bool kHostExec = Kokkos::SpaceAccessibility<ExecSpace, HostSpace>::acc
 
 /// Before a host loop whose iterations are independent although it writes through pointers the
 /// compiler cannot prove distinct from the ones it reads: lets the loop vectorise.
-#if defined(__clang__)
+#if defined(__CUDACC__) || defined(__HIPCC__) || defined(__SYCL_DEVICE_ONLY__)
+#define MFSI_IVDEP  // device compilers parse host code too; the hint matters to host builds only
+#elif defined(__clang__)
 #define MFSI_IVDEP _Pragma("clang loop vectorize(assume_safety)")
 #elif defined(__GNUC__)
 #define MFSI_IVDEP _Pragma("GCC ivdep")
