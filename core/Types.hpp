@@ -6,8 +6,10 @@
 /// mirrors live in `mfsi::HostSpace`. Works against Kokkos 3.4 and 4.x (no deprecated API).
 #include <Kokkos_Core.hpp>
 
+#include <cstddef>
 #include <cstdint>
 #include <string>
+#include <vector>
 
 namespace mfsi {
 
@@ -39,6 +41,26 @@ constexpr bool kHostExec = Kokkos::SpaceAccessibility<ExecSpace, HostSpace>::acc
 #else
 #define MFSI_IVDEP
 #endif
+
+/// \brief Unmanaged host view of n values at `data` (a source for deep_copy; no copy is made).
+template <class T>
+Kokkos::View<const T*, HostSpace, Kokkos::MemoryTraits<Kokkos::Unmanaged>> hostView(const T* data, std::size_t n) {
+  return Kokkos::View<const T*, HostSpace, Kokkos::MemoryTraits<Kokkos::Unmanaged>>(data, n);
+}
+
+/// \brief Unmanaged host view of a vector's values.
+template <class T>
+Kokkos::View<const T*, HostSpace, Kokkos::MemoryTraits<Kokkos::Unmanaged>> hostView(const std::vector<T>& v) {
+  return hostView(v.data(), v.size());
+}
+
+/// \brief A device copy of a host vector, labelled `label`.
+template <class T>
+Kokkos::View<T*, ExecSpace::memory_space> toDevice(const std::vector<T>& v, const std::string& label) {
+  Kokkos::View<T*, ExecSpace::memory_space> d(Kokkos::view_alloc(Kokkos::WithoutInitializing, label), v.size());
+  Kokkos::deep_copy(d, hostView(v));
+  return d;
+}
 
 // Device views.
 using RealView = Kokkos::View<real*, MemSpace>;

@@ -17,7 +17,6 @@ namespace mfsi {
 namespace {
 
 using DenseView = Kokkos::View<double**, Kokkos::LayoutRight, MemSpace>;
-using HostUnmanagedIdx = Kokkos::View<const lid_t*, HostSpace, Kokkos::MemoryTraits<Kokkos::Unmanaged>>;
 
 /// Eigenvalues of the coarsest operator below this fraction of the largest are treated as zero
 /// (null space of a singular system) by the pseudo-inverse.
@@ -55,24 +54,18 @@ HostCsr hostCopy(const CsrMatrix& A) {
   return h;
 }
 
-IndexView upload(const std::vector<lid_t>& v, const std::string& label) {
-  IndexView d(Kokkos::view_alloc(Kokkos::WithoutInitializing, label), v.size());
-  Kokkos::deep_copy(d, HostUnmanagedIdx(v.data(), v.size()));
-  return d;
-}
-
 /// Device CSR with the given sparsity and zero values.
 CsrMatrix makeCsr(lid_t nRows, lid_t nCols, const std::vector<lid_t>& rowPtr, const std::vector<lid_t>& colIdx,
                   const std::string& label) {
   CsrMatrix M;
   M.nRows = nRows;
   M.nCols = nCols;
-  M.rowPtr = upload(rowPtr, label + "::rowPtr");
-  M.colIdx = upload(colIdx, label + "::colIdx");
+  M.rowPtr = toDevice(rowPtr, label + "::rowPtr");
+  M.colIdx = toDevice(colIdx, label + "::colIdx");
   std::vector<lid_t> diag(nRows, -1);
   if (nRows == nCols)
     for (lid_t i = 0; i < nRows; ++i) diag[i] = findEntry(rowPtr, colIdx, i, i);
-  M.diagIdx = upload(diag, label + "::diagIdx");
+  M.diagIdx = toDevice(diag, label + "::diagIdx");
   M.values = RealView(label + "::values", colIdx.size());
   return M;
 }
@@ -472,7 +465,7 @@ detail::AmgCycleOp<S> buildCycleOp(const CsrMatrix& M, bool dropDiagonal, const 
       }
       rowPtr[i + 1] = static_cast<lid_t>(col.size());
     }
-    op.rowPtr = upload(rowPtr, label + "::rowPtr");
+    op.rowPtr = toDevice(rowPtr, label + "::rowPtr");
   }
   if (op.width > 0 && M.nRows == M.nCols) {
     // Column patterns relative to the row; up to kMaxPatterns distinct ones are kept as a table.
@@ -491,12 +484,8 @@ detail::AmgCycleOp<S> buildCycleOp(const CsrMatrix& M, bool dropDiagonal, const 
       rowPattern[i] = static_cast<std::uint8_t>(id);
     }
     if (ids.size() <= kMaxPatterns) {
-      op.pattern = Kokkos::View<std::uint8_t*, MemSpace>(
-          Kokkos::view_alloc(Kokkos::WithoutInitializing, label + "::pattern"), n);
-      Kokkos::deep_copy(op.pattern,
-                        Kokkos::View<const std::uint8_t*, HostSpace, Kokkos::MemoryTraits<Kokkos::Unmanaged>>(
-                            rowPattern.data(), rowPattern.size()));
-      op.offsets = upload(offsets, label + "::offsets");
+      op.pattern = toDevice(rowPattern, label + "::pattern");
+      op.offsets = toDevice(offsets, label + "::offsets");
       col.clear();
       // Values by column (see AmgCycleOp): src follows.
       std::vector<lid_t> byColumn(src.size());
@@ -512,16 +501,12 @@ detail::AmgCycleOp<S> buildCycleOp(const CsrMatrix& M, bool dropDiagonal, const 
           runStart.push_back(i);
         }
       op.nRuns = static_cast<lid_t>(runPattern.size());
-      op.runStart = upload(runStart, label + "::runStart");
-      op.runPattern = Kokkos::View<std::uint8_t*, MemSpace>(
-          Kokkos::view_alloc(Kokkos::WithoutInitializing, label + "::runPattern"), runPattern.size());
-      Kokkos::deep_copy(op.runPattern,
-                        Kokkos::View<const std::uint8_t*, HostSpace, Kokkos::MemoryTraits<Kokkos::Unmanaged>>(
-                            runPattern.data(), runPattern.size()));
+      op.runStart = toDevice(runStart, label + "::runStart");
+      op.runPattern = toDevice(runPattern, label + "::runPattern");
     }
   }
-  if (!col.empty()) op.col = upload(col, label + "::col");
-  op.src = upload(src, label + "::src");
+  if (!col.empty()) op.col = toDevice(col, label + "::col");
+  op.src = toDevice(src, label + "::src");
   op.val = WorkView<S>(Kokkos::view_alloc(Kokkos::WithoutInitializing, label + "::values"), src.size());
   return op;
 }
@@ -1031,10 +1016,10 @@ void AmgPreconditioner::setup(const ExecSpace& exec, const CsrMatrix& A) {
     productSparsity(nc, rPtr, rIdx, apPtr, apIdx, nc, cPtr, cIdx);
 
     const std::string pre = "mfsi::kernels::amg::level" + std::to_string(l);
-    lv[l].agg = upload(agg, pre + "::aggregate");
+    lv[l].agg = toDevice(agg, pre + "::aggregate");
     lv[l].P = makeCsr(n, nc, pPtr, pIdx, pre + "::P");
     lv[l].R = makeCsr(nc, n, rPtr, rIdx, pre + "::R");
-    lv[l].rToP = upload(rToP, pre + "::rToP");
+    lv[l].rToP = toDevice(rToP, pre + "::rToP");
     lv[l].AP = makeCsr(n, nc, apPtr, apIdx, pre + "::AP");
     Level next;
     next.A = makeCsr(nc, nc, cPtr, cIdx, "mfsi::kernels::amg::level" + std::to_string(l + 1) + "::A");

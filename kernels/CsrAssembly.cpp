@@ -5,15 +5,6 @@
 
 namespace mfsi {
 
-namespace {
-
-template <class T>
-Kokkos::View<const T*, HostSpace, Kokkos::MemoryTraits<Kokkos::Unmanaged>> hostView(const std::vector<T>& v) {
-  return Kokkos::View<const T*, HostSpace, Kokkos::MemoryTraits<Kokkos::Unmanaged>>(v.data(), v.size());
-}
-
-}  // namespace
-
 NodeItemMap buildNodeItemMap(const std::vector<std::array<lid_t, kMaxItemNodes>>& itemNodes, lid_t nNodes,
                              const std::string& label) {
   std::vector<lid_t> offsets(nNodes + 1, 0);

@@ -9,45 +9,6 @@ namespace mfsi {
 
 namespace {
 
-IndexView uploadIndex(const std::vector<lid_t>& v, const std::string& label) {
-  IndexView d(Kokkos::view_alloc(Kokkos::WithoutInitializing, label), v.size());
-  Kokkos::deep_copy(d, Kokkos::View<const lid_t*, HostSpace, Kokkos::MemoryTraits<Kokkos::Unmanaged>>(v.data(), v.size()));
-  return d;
-}
-
-/// Row runs of a sparsity (see CsrRowRuns), or none when the average run would be shorter than
-/// kMinMeanRun rows (the run kernels then gain nothing over the row kernels).
-CsrRowRuns rowRuns(lid_t nRows, const std::vector<lid_t>& rowPtr, const std::vector<lid_t>& colIdx,
-                        const std::string& label) {
-  constexpr double kMinMeanRun = 8.0;
-  CsrRowRuns runs;
-  if (nRows == 0) return runs;
-  std::map<std::vector<lid_t>, lid_t> patterns;  // relative columns -> where they sit in `offsets`
-  std::vector<lid_t> start, offsetsAt, offsets, blockStart, key, previous;
-  for (lid_t i = 0; i < nRows; ++i) {
-    key.assign(colIdx.begin() + rowPtr[i], colIdx.begin() + rowPtr[i + 1]);
-    for (lid_t& c : key) c -= i;
-    const bool newBlock = i % kRowBlock == 0;
-    if (newBlock) blockStart.push_back(static_cast<lid_t>(start.size()));
-    if (newBlock || key != previous) {
-      const auto [it, added] = patterns.emplace(key, static_cast<lid_t>(offsets.size()));
-      if (added) offsets.insert(offsets.end(), key.begin(), key.end());
-      start.push_back(i);
-      offsetsAt.push_back(it->second);
-      previous = key;
-    }
-  }
-  if (static_cast<double>(nRows) < kMinMeanRun * static_cast<double>(start.size())) return runs;
-  start.push_back(nRows);
-  blockStart.push_back(static_cast<lid_t>(offsetsAt.size()));
-  runs.count = static_cast<lid_t>(offsetsAt.size());
-  runs.start = uploadIndex(start, label + "::runs::start");
-  runs.offsetsAt = uploadIndex(offsetsAt, label + "::runs::offsetsAt");
-  runs.offsets = uploadIndex(offsets.empty() ? std::vector<lid_t>{0} : offsets, label + "::runs::offsets");
-  runs.blockStart = uploadIndex(blockStart, label + "::runs::blockStart");
-  return runs;
-}
-
 /// Copy host CSR arrays into a device CsrMatrix (values zeroed, diagIdx found by search).
 CsrMatrix upload(lid_t nRows, lid_t nCols, const std::vector<lid_t>& rowPtr, const std::vector<lid_t>& colIdx,
                  const std::string& label) {
@@ -60,13 +21,10 @@ CsrMatrix upload(lid_t nRows, lid_t nCols, const std::vector<lid_t>& rowPtr, con
   A.values = RealView(label + "::values", colIdx.size());
   std::vector<lid_t> diag(nRows);
   for (lid_t i = 0; i < nRows; ++i) diag[i] = findEntry(rowPtr, colIdx, i, i);
-  Kokkos::deep_copy(A.rowPtr, Kokkos::View<const lid_t*, HostSpace, Kokkos::MemoryTraits<Kokkos::Unmanaged>>(
-                                  rowPtr.data(), rowPtr.size()));
-  Kokkos::deep_copy(A.colIdx, Kokkos::View<const lid_t*, HostSpace, Kokkos::MemoryTraits<Kokkos::Unmanaged>>(
-                                  colIdx.data(), colIdx.size()));
-  Kokkos::deep_copy(A.diagIdx, Kokkos::View<const lid_t*, HostSpace, Kokkos::MemoryTraits<Kokkos::Unmanaged>>(
-                                   diag.data(), diag.size()));
-  A.runs = rowRuns(nRows, rowPtr, colIdx, label);
+  Kokkos::deep_copy(A.rowPtr, hostView(rowPtr));
+  Kokkos::deep_copy(A.colIdx, hostView(colIdx));
+  Kokkos::deep_copy(A.diagIdx, hostView(diag));
+  A.runs = buildRowRuns(nRows, rowPtr, colIdx, label);
   return A;
 }
 
@@ -100,9 +58,37 @@ CsrMatrix finish(lid_t nNodes, const std::vector<lid_t>& offsets, const std::vec
 
 }  // namespace
 
+/// Row runs of a sparsity (see CsrRowRuns), or none when the average run would be shorter than
+/// kMinMeanRun rows (the run kernels then gain nothing over the row kernels).
 CsrRowRuns buildRowRuns(lid_t nRows, const std::vector<lid_t>& rowPtr, const std::vector<lid_t>& colIdx,
                         const std::string& label) {
-  return rowRuns(nRows, rowPtr, colIdx, label);
+  constexpr double kMinMeanRun = 8.0;
+  CsrRowRuns runs;
+  if (nRows == 0) return runs;
+  std::map<std::vector<lid_t>, lid_t> patterns;  // relative columns -> where they sit in `offsets`
+  std::vector<lid_t> start, offsetsAt, offsets, blockStart, key, previous;
+  for (lid_t i = 0; i < nRows; ++i) {
+    key.assign(colIdx.begin() + rowPtr[i], colIdx.begin() + rowPtr[i + 1]);
+    for (lid_t& c : key) c -= i;
+    const bool newBlock = i % kRowBlock == 0;
+    if (newBlock) blockStart.push_back(static_cast<lid_t>(start.size()));
+    if (newBlock || key != previous) {
+      const auto [it, added] = patterns.emplace(key, static_cast<lid_t>(offsets.size()));
+      if (added) offsets.insert(offsets.end(), key.begin(), key.end());
+      start.push_back(i);
+      offsetsAt.push_back(it->second);
+      previous = key;
+    }
+  }
+  if (static_cast<double>(nRows) < kMinMeanRun * static_cast<double>(start.size())) return runs;
+  start.push_back(nRows);
+  blockStart.push_back(static_cast<lid_t>(offsetsAt.size()));
+  runs.count = static_cast<lid_t>(offsetsAt.size());
+  runs.start = toDevice(start, label + "::runs::start");
+  runs.offsetsAt = toDevice(offsetsAt, label + "::runs::offsetsAt");
+  runs.offsets = toDevice(offsets.empty() ? std::vector<lid_t>{0} : offsets, label + "::runs::offsets");
+  runs.blockStart = toDevice(blockStart, label + "::runs::blockStart");
+  return runs;
 }
 
 lid_t findEntry(const std::vector<lid_t>& rowPtr, const std::vector<lid_t>& colIdx, lid_t row, lid_t col) {

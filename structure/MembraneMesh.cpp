@@ -31,11 +31,6 @@ Vec3 areaVector(const std::vector<Vec3>& p, const std::array<lid_t, 4>& e) {
   return {0.5 * c[0], 0.5 * c[1], 0.5 * c[2]};
 }
 
-template <class T>
-Kokkos::View<const T*, HostSpace, Kokkos::MemoryTraits<Kokkos::Unmanaged>> hostView(const T* data, std::size_t n) {
-  return Kokkos::View<const T*, HostSpace, Kokkos::MemoryTraits<Kokkos::Unmanaged>>(data, n);
-}
-
 /// Merge nodes closer than tol (relative to the bounding box) and renumber elements and node
 /// sets; used by the block generators to glue blocks.
 void mergeCoincidentNodes(MembraneMeshInput& m, real relTol = 1e-9) {

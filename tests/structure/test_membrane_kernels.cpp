@@ -62,14 +62,6 @@ std::vector<double> copyToHost(const RealView& v) {
   return std::vector<double>(h.data(), h.data() + h.extent(0));
 }
 
-RealView toDevice(const std::vector<double>& v, const std::string& label) {
-  RealView d(label, v.size());
-  auto h = Kokkos::create_mirror_view(d);
-  for (std::size_t i = 0; i < v.size(); ++i) h(i) = v[i];
-  Kokkos::deep_copy(d, h);
-  return d;
-}
-
 /// Host reference: element forces f_ext - f_int in covariant form. S^ab = lambda' G^ab G^cd E_cd +
 /// mu (G^ac G^bd + G^ad G^bc) E_cd + (T0/h) G^ab with lambda' = E nu/(1 - nu^2), mu = E/(2(1+nu));
 /// f_int,A = int h S^ab N_A,a g_b dA0; f_ext,A = int p N_A (g_1 x g_2) dxi deta.
