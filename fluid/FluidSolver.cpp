@@ -20,6 +20,29 @@ KOKKOS_INLINE_FUNCTION real limiter(ConvectionScheme s, real r) {
   return (r + ar) / (1.0 + ar);  // van Leer
 }
 
+/// Rhie-Chow correction flux of internal face f (owner o, neighbour n) stored for the next step:
+/// phi_f minus the flux of the linearly interpolated cell velocities. storeDdtCorrection and the
+/// fused finishStep share it.
+KOKKOS_INLINE_FUNCTION real ddtCorrectionFlux(lid_t f, lid_t o, lid_t n, const ConstRealView& w,
+                                              const ConstRealView& phi, const ConstReal3View& U,
+                                              const ConstReal3View& sf) {
+  real s = 0;
+  for (int k = 0; k < 3; ++k) s += (w(f) * U(o, k) + (1.0 - w(f)) * U(n, k)) * sf(f, k);
+  return phi(f) - s;
+}
+
+/// Sum of |U| and |p| of a cell: summed over the cells it is finite iff every field value is.
+KOKKOS_INLINE_FUNCTION real fieldMagnitude(lid_t c, const ConstReal3View& U, const ConstRealView& p) {
+  return kmath::fabs(U(c, 0)) + kmath::fabs(U(c, 1)) + kmath::fabs(U(c, 2)) + kmath::fabs(p(c));
+}
+
+/// Pressure-equation coefficient of internal face f: the face-interpolated rAU over the distance.
+KOKKOS_INLINE_FUNCTION real pressureFaceCoefficient(lid_t f, lid_t o, lid_t n, const ConstRealView& w,
+                                                    const ConstRealView& rAU, const ConstRealView& dc) {
+  const real wf = w(f);
+  return (wf * rAU(o) + (1.0 - wf) * rAU(n)) * dc(f);
+}
+
 /// One row of FluidSolver::assembleMomentumFused (see there). A named functor rather than a
 /// lambda: the compiler then inlines the call into the launch loop (a lambda this size was called
 /// per cell).
@@ -786,7 +809,7 @@ void FluidSolver::assemblePressureMatrix() {
   ScopedRegion region("mfsi::fluid::pressure::assemble");
   // The matrix depends on rAU and the geometry only: the same for every pressure corrector of one
   // outer iteration, so it is assembled once per outer iteration (the source every corrector).
-  if (opt_.fusedMomentumAssembly && opt_.reduction == ReductionMode::Gather)
+  if (fusedCellPasses())
     assemblePressureMatrixFused();
   else
     assemblePressureMatrixFaces();
@@ -822,8 +845,7 @@ void FluidSolver::assemblePressureMatrixFused() {
         for (lid_t e = off(cell); e < off(cell + 1); ++e) {
           const lid_t f = cf(e);
           if (f < nIn) {
-            const real wf = w(f);
-            const real coef = (wf * rAU(own(f)) + (1.0 - wf) * rAU(nei(f))) * dc(f);
+            const real coef = pressureFaceCoefficient(f, own(f), nei(f), w, rAU, dc);
             diag += coef;
             vals(cfp(e)) += -coef;
           } else {
@@ -845,9 +867,7 @@ void FluidSolver::assemblePressureMatrixFaces() {
       "mfsi::fluid::pressure::faceCoefficients", RangePolicy(exec_, 0, nFaces_), KOKKOS_LAMBDA(lid_t f) {
         const lid_t o = own(f);
         if (f < nIn) {
-          const lid_t n = nei(f);
-          const real wf = w(f);
-          const real coef = (wf * rAU(o) + (1.0 - wf) * rAU(n)) * dc(f);
+          const real coef = pressureFaceCoefficient(f, o, nei(f), w, rAU, dc);
           od(f) = nd(f) = coef;
           up(f) = lo(f) = -coef;
         } else {
@@ -875,6 +895,10 @@ void FluidSolver::assemblePressureMatrixFaces() {
 }
 
 bool FluidSolver::fusedPressureSource() const { return opt_.fusedMomentumAssembly && !nonOrthogonal_; }
+
+bool FluidSolver::fusedCellPasses() const {
+  return opt_.fusedMomentumAssembly && opt_.reduction == ReductionMode::Gather;
+}
 
 void FluidSolver::pressureSourceFlux() {
   // computePhiHbyA and the face loop of assemblePressureSource in one kernel, for orthogonal
@@ -1021,13 +1045,7 @@ void FluidSolver::storeDdtCorrection() {
   const lid_t nIn = nIn_;
   Kokkos::parallel_for(
       "mfsi::fluid::ddtCorr::store", RangePolicy(exec_, 0, nFaces_), KOKKOS_LAMBDA(lid_t f) {
-        if (f < nIn) {
-          real s = 0;
-          for (int k = 0; k < 3; ++k) s += (w(f) * U(own(f), k) + (1.0 - w(f)) * U(nei(f), k)) * sf(f, k);
-          d(f) = phi(f) - s;
-        } else {
-          d(f) = 0.0;
-        }
+        d(f) = f < nIn ? ddtCorrectionFlux(f, own(f), nei(f), w, phi, U, sf) : 0.0;
       });
   dphiLatest_ = true;
 }
@@ -1070,21 +1088,13 @@ real FluidSolver::finishStep(real& sum, bool& finite) {
           const lid_t f = cf(e);
           const bool isOwner = own(f) == c;
           div += (isOwner ? 1.0 : -1.0) * phi(f);
-          if (!isOwner) continue;
-          if (f < nIn) {
-            const lid_t n = nei(f);
-            real sU = 0;
-            for (int k = 0; k < 3; ++k) sU += (w(f) * U(c, k) + (1.0 - w(f)) * U(n, k)) * sf(f, k);
-            d(f) = phi(f) - sU;
-          } else {
-            d(f) = 0.0;
-          }
+          if (isOwner) d(f) = f < nIn ? ddtCorrectionFlux(f, c, nei(f), w, phi, U, sf) : 0.0;
         }
         const real a = kmath::fabs(1.0 * div);
         const real r = a / V(c);
         m = r > m ? r : m;
         s += a;
-        acc += kmath::fabs(U(c, 0)) + kmath::fabs(U(c, 1)) + kmath::fabs(U(c, 2)) + kmath::fabs(p(c));
+        acc += fieldMagnitude(c, U, p);
       },
       Kokkos::Max<real>(mx), sum, fin);
   dphiLatest_ = true;
@@ -1098,10 +1108,7 @@ bool FluidSolver::fieldsFinite() {
   real s = 0;
   Kokkos::parallel_reduce(
       "mfsi::fluid::finiteCheck", RangePolicy(exec_, 0, nCells_),
-      KOKKOS_LAMBDA(lid_t c, real & acc) {
-        acc += kmath::fabs(U(c, 0)) + kmath::fabs(U(c, 1)) + kmath::fabs(U(c, 2)) + kmath::fabs(p(c));
-      },
-      s);
+      KOKKOS_LAMBDA(lid_t c, real & acc) { acc += fieldMagnitude(c, U, p); }, s);
   return std::isfinite(s);
 }
 
@@ -1249,7 +1256,7 @@ StepResult FluidSolver::solve() {
     }
     if (!res.ok) break;
   }
-  if (opt_.fusedMomentumAssembly && opt_.reduction == ReductionMode::Gather) {
+  if (fusedCellPasses()) {
     bool finite = true;
     res.continuityMax = finishStep(res.continuitySum, finite);
     if (!finite || !std::isfinite(res.continuityMax)) res.ok = false;

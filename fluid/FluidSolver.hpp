@@ -148,6 +148,8 @@ class FluidSolver {
   void assemblePressureMatrixFaces();
   void assemblePressureSource();
   bool fusedPressureSource() const;
+  /// The fused per-cell pressure-matrix and end-of-step passes apply (Gather reduction).
+  bool fusedCellPasses() const;
   void pressureSourceFlux();
   void pressureSourceFluxFaces();
   void finishPressureSource();

@@ -17,8 +17,7 @@ void spmv(const ExecSpace& exec, real alpha, const CsrMatrix& A, const ConstReal
     exec.fence();
     Kokkos::parallel_for("mfsi::kernels::blas::spmv", detail::hostPolicy(exec, 0, A.runs.count), [=](lid_t r) {
       detail::forRunRows(R, r, [&](lid_t i, const double* v, const lid_t* off, auto width) {
-        double s = 0.0;
-        for (int k = 0; k < width; ++k) s += v[k] * xp[i + off[k]];
+        const double s = detail::runRowDot(v, xp, i, off, width);
         yp[i] = beta == 0.0 ? alpha * s : alpha * s + beta * yp[i];
       });
     });
@@ -46,9 +45,7 @@ double spmvDot(const ExecSpace& exec, const SolverComm& comm, const CsrMatrix& A
         exec, comm, "mfsi::kernels::blas::spmvDot", A,
         [=](lid_t r) {
           detail::forRunRows(R, r, [&](lid_t i, const double* v, const lid_t* off, auto width) {
-            double ax = 0.0;
-            for (int k = 0; k < width; ++k) ax += v[k] * xp[i + off[k]];
-            yp[i] = ax;
+            yp[i] = detail::runRowDot(v, xp, i, off, width);
           });
         },
         [=](lid_t i, Sums<1>& s) { s[0] += wp[i] * yp[i]; })[0];

@@ -146,6 +146,14 @@ inline void forRunRows(const RunView& R, lid_t r, const Row& row) {
   }
 }
 
+/// sum_k v[k] x[i + off[k]]: one row of A x inside forRunRows, in the row kernels' order.
+template <class Width>
+inline double runRowDot(const double* v, const double* x, lid_t i, const lid_t* off, Width width) {
+  double s = 0.0;
+  for (int k = 0; k < width; ++k) s += v[k] * x[i + off[k]];
+  return s;
+}
+
 /// `reduce` over a matrix's runs: per block of kRowBlock rows, runBody(r) for the block's runs in
 /// order (writing per-row results), then rowSum(i, sums) for its rows in order.
 template <int N, class RunBody, class RowSum>
