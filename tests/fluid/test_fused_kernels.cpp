@@ -3,9 +3,9 @@
 // configurations those paths branch on; the time-level bookkeeping that skips copies (static or
 // intermittently moving meshes, Euler vs BDF2, repeated beginStep); and that the per-face arrays
 // the fused paths no longer need are not allocated.
-#include "core/BlockMesh.hpp"
 #include "fluid/FluidSolver.hpp"
 #include "support/Approx.hpp"
+#include "support/FluidCases.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -19,21 +19,9 @@ using namespace mfsi::fluid;
 
 namespace {
 
-HexMesh cavity(int n) {
-  auto spec = boxSpec({0, 0, 0}, {1, 1, 1}, {n, n, n});
-  spec.blocks[0].patches = {"walls", "walls", "walls", "lid", "walls", "walls"};
-  spec.patchKinds = {{"walls", PatchKind::Wall}, {"lid", PatchKind::Wall}};
-  return buildHexMesh(generateBlockMesh(spec));
-}
-
-/// Inflow x-, outlet x+, fixed bottom wall, moving lid, slip sides.
-HexMesh channel() {
-  auto spec = boxSpec({0, 0, 0}, {2.0, 1.0, 0.6}, {8, 5, 4});
-  spec.blocks[0].grading = {1.5, 0.8, 1.0};
-  spec.blocks[0].patches = {"inlet", "outlet", "bottom", "lid", "sides", "sides"};
-  spec.patchKinds = {{"bottom", PatchKind::Wall}, {"lid", PatchKind::Wall}, {"sides", PatchKind::Symmetry}};
-  return buildHexMesh(generateBlockMesh(spec));
-}
+using test::channelBoxMesh;
+using test::channelFlowOptions;
+using test::cubeCavityMesh;
 
 FluidOptions cavityOptions() {
   FluidOptions o;
@@ -45,24 +33,6 @@ FluidOptions cavityOptions() {
   o.pressureSolver = {1e-12, 0.0, 500};
   o.boundaries["lid"].type = BoundaryType::Wall;
   o.boundaries["lid"].velocity = {1.0, 0.0, 0.0};
-  return o;
-}
-
-FluidOptions channelOptions(TimeScheme time) {
-  FluidOptions o;
-  o.viscosity = 0.02;
-  o.timeScheme = time;
-  o.bodyForce = {0.1, -0.3, 0.0};
-  o.pimple.nOuterCorrectors = 2;
-  o.pimple.nCorrectors = 2;
-  o.momentumSolver = {1e-12, 0.0, 500};
-  o.pressureSolver = {1e-12, 0.0, 500};
-  o.boundaries["inlet"].type = BoundaryType::FixedVelocity;
-  o.boundaries["inlet"].velocity = {1.0, 0.2, 0.0};
-  o.boundaries["outlet"].type = BoundaryType::FixedPressure;
-  o.boundaries["outlet"].pressure = 0.5;
-  o.boundaries["lid"].type = BoundaryType::Wall;
-  o.boundaries["lid"].velocity = {-0.5, 0.0, 0.0};
   return o;
 }
 
@@ -145,8 +115,8 @@ TEST(FusedKernels, FusedPathsEqualTheFacePaths) {
   // compressibility (cell diagonal and old pressures), pressure relaxation, non-orthogonal
   // correctors on an orthogonal mesh, a resistance outlet (boundary pressure changing every
   // corrector), Euler and BDF2 (second old level read or skipped).
-  const HexMesh box = cavity(6);
-  const HexMesh chan = channel();
+  const HexMesh box = cubeCavityMesh(6);
+  const HexMesh chan = channelBoxMesh();
   struct Case {
     std::string name;
     const HexMesh* mesh;
@@ -166,10 +136,10 @@ TEST(FusedKernels, FusedPathsEqualTheFacePaths) {
     o.pimple.nNonOrthogonalCorrectors = 1;
     cases.push_back({"cavity relaxed", &box, o});
   }
-  cases.push_back({"channel Euler", &chan, channelOptions(TimeScheme::Euler)});
-  cases.push_back({"channel BDF2", &chan, channelOptions(TimeScheme::BDF2)});
+  cases.push_back({"channel Euler", &chan, channelFlowOptions(TimeScheme::Euler)});
+  cases.push_back({"channel BDF2", &chan, channelFlowOptions(TimeScheme::BDF2)});
   {
-    FluidOptions o = channelOptions(TimeScheme::BDF2);
+    FluidOptions o = channelFlowOptions(TimeScheme::BDF2);
     o.boundaries["outlet"].type = BoundaryType::Resistance;
     o.boundaries["outlet"].resistance = 2.0;
     cases.push_back({"channel resistance", &chan, o});
@@ -186,8 +156,8 @@ TEST(FusedKernels, MovingMeshPathsEqualTheFacePaths) {
   // while the source flux and momentum take the face paths; motion in some steps only exercises
   // the skipped copies of volumes, positions and swept volumes.
   for (TimeScheme time : {TimeScheme::Euler, TimeScheme::BDF2}) {
-    HexMesh meshA = channel(), meshB = channel();
-    FluidOptions o = channelOptions(time);
+    HexMesh meshA = channelBoxMesh(), meshB = channelBoxMesh();
+    FluidOptions o = channelFlowOptions(time);
     o.pimple.nNonOrthogonalCorrectors = 1;
     FluidOptions unfused = o;
     unfused.fusedMomentumAssembly = false;
@@ -214,7 +184,7 @@ TEST(FusedKernels, UniformFlowStaysUniformWithIntermittentMotion) {
   // swept volumes that beginStep now copies only after motion must still be those of the step.
   // A stale V0 or swept volume breaks the balance and the uniform flow with it.
   for (TimeScheme time : {TimeScheme::Euler, TimeScheme::BDF2}) {
-    HexMesh mesh = channel();
+    HexMesh mesh = channelBoxMesh();
     const Vec3 U0{1.0, 0.5, -0.25};
     FluidOptions o;
     o.viscosity = 0.05;
@@ -256,7 +226,7 @@ TEST(FusedKernels, RepeatedBeginStepChangesNothingWithEuler) {
   // With Euler a second beginStep(t, dt) before solve() copies the same time levels again: no
   // effect. The correction fluxes are handed on between arrays instead of copied, so the second
   // call must find the latest ones where the first left them.
-  const HexMesh mesh = cavity(6);
+  const HexMesh mesh = cubeCavityMesh(6);
   FluidOptions o = cavityOptions();
   // The extrapolated momentum guess reads the step before the last one, which a repeated
   // beginStep does replace: off here, the time levels are what is compared.
@@ -276,7 +246,7 @@ TEST(FusedKernels, FusedPathsAllocateNoPerFaceCoefficients) {
   // The fused passes never read the per-face coefficient arrays (8 doubles per face for the two
   // matrices), the explicit momentum face fluxes (3) or phiHbyA (1): they are allocated on first
   // use by the face paths only.
-  const HexMesh mesh = cavity(4);
+  const HexMesh mesh = cubeCavityMesh(4);
   const std::vector<std::string> lazy = {"mfsi::fluid::momentum::face::ownerDiag", "mfsi::fluid::pressure::face::upper",
                                          "mfsi::fluid::momentum::faceFlux", "mfsi::fluid::phiHbyA"};
   for (bool fused : {true, false}) {

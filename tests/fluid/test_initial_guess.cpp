@@ -2,8 +2,8 @@
 // solves start, so a transient cavity gives the same fields (to the solvers' tolerances) with
 // fewer momentum and pressure iterations; and repeated solves of one step (FSI coupling
 // iterations) start from the last iterate, not from a new extrapolation.
-#include "core/BlockMesh.hpp"
 #include "fluid/FluidSolver.hpp"
+#include "support/FluidCases.hpp"
 #include "support/HostVectors.hpp"
 
 #include <gtest/gtest.h>
@@ -18,13 +18,6 @@ using namespace mfsi::fluid;
 namespace {
 
 constexpr double kDt = 0.005;
-
-HexMesh cavityMesh() {
-  auto spec = boxSpec({0, 0, 0}, {1, 1, 1}, {12, 12, 12});
-  spec.blocks[0].patches = {"walls", "walls", "walls", "lid", "walls", "walls"};
-  spec.patchKinds = {{"walls", PatchKind::Wall}, {"lid", PatchKind::Wall}};
-  return buildHexMesh(generateBlockMesh(spec));
-}
 
 FluidOptions cavityOptions(bool extrapolate) {
   FluidOptions o;
@@ -69,7 +62,7 @@ Outcome run(const HexMesh& mesh, bool extrapolate, int steps) {
 }  // namespace
 
 TEST(InitialGuess, SameFieldsWithFewerIterations) {
-  const HexMesh mesh = cavityMesh();
+  const HexMesh mesh = test::cubeCavityMesh(12);
   const Outcome off = run(mesh, false, 20), on = run(mesh, true, 20);
   double du = 0;
   for (int c = 0; c < 3; ++c) du = std::max(du, test::relDiff(on.U[c], off.U[c]));
@@ -88,7 +81,7 @@ TEST(InitialGuess, SameFieldsWithFewerIterations) {
 TEST(InitialGuess, RepeatedSolvesOfOneStepStartFromTheLastIterate) {
   // A second solve() of the same step (an FSI coupling iteration with unchanged boundaries) starts
   // from the first solve's velocity, not from a new extrapolation.
-  const HexMesh mesh = cavityMesh();
+  const HexMesh mesh = test::cubeCavityMesh(12);
   FluidSolver fluid(mesh, cavityOptions(true));
   for (int s = 0; s < 4; ++s) ASSERT_TRUE(fluid.solveStep(s * kDt, kDt).ok);
   fluid.beginStep(4 * kDt, kDt);

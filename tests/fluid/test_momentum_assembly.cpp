@@ -2,10 +2,10 @@
 // orthogonal meshes: same fields after several PISO steps with every boundary kind it handles, for
 // linear and upwind convection and both time schemes. Also: the velocity gradient the solver skips
 // on such meshes is still served, on request, for the loads.
-#include "core/BlockMesh.hpp"
 #include "fluid/FluidSolver.hpp"
 #include "fluid/Gradient.hpp"
 #include "support/Approx.hpp"
+#include "support/FluidCases.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -16,35 +16,11 @@ using namespace mfsi::fluid;
 
 namespace {
 
-/// Channel-like box: inflow x-, pressure outlet x+, fixed bottom wall, moving lid, and the z sides
-/// either slip planes (3D) or empty (one cell thick, 2D).
-HexMesh channelBox(bool twoD) {
-  auto spec = boxSpec({0, 0, 0}, {2.0, 1.0, twoD ? 0.1 : 0.6}, {8, 5, twoD ? 1 : 4});
-  spec.blocks[0].grading = {1.5, 0.8, 1.0};
-  spec.blocks[0].patches = {"inlet", "outlet", "bottom", "lid", "sides", "sides"};
-  spec.patchKinds = {{"bottom", PatchKind::Wall}, {"lid", PatchKind::Wall},
-                     {"sides", twoD ? PatchKind::Empty : PatchKind::Symmetry}};
-  return buildHexMesh(generateBlockMesh(spec));
-}
-
 FluidOptions options(ConvectionScheme conv, TimeScheme time, bool fused) {
-  FluidOptions o;
-  o.viscosity = 0.02;
+  FluidOptions o = test::channelFlowOptions(time);
   o.convection = conv;
-  o.timeScheme = time;
   o.fusedMomentumAssembly = fused;
-  o.bodyForce = {0.1, -0.3, 0.0};
-  o.pimple.nOuterCorrectors = 2;
-  o.pimple.nCorrectors = 2;
   o.pimple.relaxVelocity = 0.9;
-  o.momentumSolver = {1e-12, 0.0, 500};
-  o.pressureSolver = {1e-12, 0.0, 500};
-  o.boundaries["inlet"].type = BoundaryType::FixedVelocity;
-  o.boundaries["inlet"].velocity = {1.0, 0.2, 0.0};
-  o.boundaries["outlet"].type = BoundaryType::FixedPressure;
-  o.boundaries["outlet"].pressure = 0.5;
-  o.boundaries["lid"].type = BoundaryType::Wall;
-  o.boundaries["lid"].velocity = {-0.5, 0.0, 0.0};
   return o;
 }
 
@@ -67,7 +43,7 @@ Fields run(const HexMesh& mesh, const FluidOptions& o, int steps) {
 
 TEST(MomentumAssembly, FusedPassEqualsTheFaceCoefficientPath) {
   for (bool twoD : {false, true}) {
-    const HexMesh mesh = channelBox(twoD);
+    const HexMesh mesh = test::channelBoxMesh(twoD);
     for (ConvectionScheme conv : {ConvectionScheme::Linear, ConvectionScheme::Upwind}) {
       for (TimeScheme time : {TimeScheme::Euler, TimeScheme::BDF2}) {
         const std::string what = std::string(twoD ? "2D" : "3D") + (conv == ConvectionScheme::Linear ? " linear" : " upwind") +
@@ -95,7 +71,7 @@ TEST(MomentumAssembly, FusedPassEqualsTheFaceCoefficientPath) {
 }
 
 TEST(MomentumAssembly, VelocityGradientIsServedWhenTheSolverSkippedIt) {
-  const HexMesh mesh = channelBox(false);
+  const HexMesh mesh = test::channelBoxMesh(false);
   FluidSolver fluid(mesh, options(ConvectionScheme::Linear, TimeScheme::Euler, true));
   for (int s = 0; s < 2; ++s) ASSERT_TRUE(fluid.solveStep(s * 0.05, 0.05).ok);
   Tensor3View expected("test::gradU", mesh.nCells());

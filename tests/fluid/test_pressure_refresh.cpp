@@ -2,8 +2,8 @@
 // `pressurePreconditionerRefresh` outer iterations, and earlier once the final pressure solve needs
 // more than `pressurePreconditionerStaleRatio` times (+1) the iterations it needed right after the
 // last refresh. Refreshes are counted through the AMG's Kokkos region.
-#include "core/BlockMesh.hpp"
 #include "fluid/FluidSolver.hpp"
+#include "support/FluidCases.hpp"
 
 #include <gtest/gtest.h>
 
@@ -21,10 +21,7 @@ void countRegion(const char* name) {
 
 /// Value refreshes of the AMG over `steps` PISO steps of a 3D cavity (the set-up is not counted).
 int refreshes(int period, double staleRatio, int steps, int& iterations) {
-  auto spec = boxSpec({0, 0, 0}, {1, 1, 1}, {10, 10, 10});
-  spec.blocks[0].patches = {"walls", "walls", "walls", "lid", "walls", "walls"};
-  spec.patchKinds = {{"walls", PatchKind::Wall}, {"lid", PatchKind::Wall}};
-  const HexMesh mesh = buildHexMesh(generateBlockMesh(spec));
+  const HexMesh mesh = test::cubeCavityMesh(10);
   FluidOptions o;
   o.viscosity = 0.01;
   o.timeScheme = TimeScheme::Euler;
