@@ -151,6 +151,81 @@ std::vector<lid_t> aggregate(const HostCsr& A, double theta, lid_t& nAgg) {
   return agg;
 }
 
+/// The lattice of a host matrix (see detectLattice). Row 0's neighbours give the strides: 1, nx
+/// and nx ny on a 3D lattice (its x, y and z neighbours), 1 and nx on a 2D one; then every row
+/// must hold exactly the columns its lattice position implies.
+AmgLattice latticeOf(const HostCsr& A) {
+  const lid_t n = A.nRows;
+  if (n < 4 || A.rowPtr.size() != static_cast<std::size_t>(n) + 1) return {};
+  std::vector<lid_t> strides;
+  for (lid_t k = A.rowPtr[0]; k < A.rowPtr[1]; ++k)
+    if (A.colIdx[k] != 0) strides.push_back(A.colIdx[k]);
+  AmgLattice g;
+  if (strides.size() == 3 && strides[0] == 1 && strides[1] >= 2 && strides[2] % strides[1] == 0 &&
+      n % strides[2] == 0) {
+    g = {strides[1], strides[2] / strides[1], n / strides[2]};
+  } else if (strides.size() == 2 && strides[0] == 1 && strides[1] >= 2 && n % strides[1] == 0) {
+    g = {strides[1], n / strides[1], 1};
+  } else {
+    return {};
+  }
+  if (g.ny < 2 || (strides.size() == 3 && g.nz < 2)) return {};
+  const lid_t sy = g.nx, sz = g.nx * g.ny;
+  lid_t expected[7];
+  for (lid_t i = 0; i < n; ++i) {
+    const lid_t x = i % g.nx, y = (i / g.nx) % g.ny, z = i / sz;
+    int m = 0;
+    if (z > 0) expected[m++] = i - sz;
+    if (y > 0) expected[m++] = i - sy;
+    if (x > 0) expected[m++] = i - 1;
+    expected[m++] = i;
+    if (x + 1 < g.nx) expected[m++] = i + 1;
+    if (y + 1 < g.ny) expected[m++] = i + sy;
+    if (z + 1 < g.nz) expected[m++] = i + sz;
+    if (A.rowPtr[i + 1] - A.rowPtr[i] != m) return {};
+    for (int k = 0; k < m; ++k)
+      if (A.colIdx[A.rowPtr[i] + k] != expected[k]) return {};
+  }
+  return g;
+}
+
+/// Whether every off-diagonal coupling is strong, |a_ij| >= theta sqrt(|a_ii a_jj|). Cube
+/// aggregates assume it: on an anisotropic lattice (stretched cells) the greedy aggregation
+/// follows the strong direction, cubes would not.
+bool allStrong(const HostCsr& A, double theta) {
+  for (lid_t i = 0; i < A.nRows; ++i) {
+    const double di = std::abs(A.values[A.diagIdx[i]]);
+    for (lid_t k = A.rowPtr[i]; k < A.rowPtr[i + 1]; ++k) {
+      const lid_t j = A.colIdx[k];
+      const double a = std::abs(A.values[k]), dj = std::abs(A.values[A.diagIdx[j]]);
+      if (j != i && !(a * a >= theta * theta * di * dj && a * a > kNegligible * kNegligible * di * dj)) return false;
+    }
+  }
+  return true;
+}
+
+/// Lattice-aligned aggregates: f x f x f cubes (f x f on a one-cell-thick lattice), numbered
+/// lexicographically on the coarse lattice `coarse` (extents ceil(n / f)). An extent that f does
+/// not divide ends with a narrower layer of aggregates rather than a wider one: with f = 2 the
+/// restriction rows then stay at most 32 long (a fixed ELL width; three-wide aggregates give 44).
+///
+/// Why f = 2 on the finest level and 3 below (setup): the 7-point finest operator gives a level-1
+/// operator of 33 points (3 x 3 x 3 neighbouring cubes and two more along each axis); 2x2x2
+/// cubes of that give a 139-point level 2 (operator complexity 1.88 at 64^3), 3x3x3 cubes a
+/// 61-point one (1.61) and the same coarsening ratio as greedy aggregation on those levels
+/// (~27-40), but compact and aligned. Measured on the 3D cavity at 64^3 (perf/bench_cavity3d),
+/// AMG-CG iterations per step: greedy 8.53; cubes on level 0 only, greedy below 10.0; 2-cubes on
+/// levels 0 and 1 8.67, on levels 0-2 7.67; 2-cubes on level 0 and 3-cubes below 7.53.
+std::vector<lid_t> latticeAggregates(const AmgLattice& g, AmgLattice& coarse, lid_t& nAgg, lid_t f) {
+  coarse = {(g.nx + f - 1) / f, (g.ny + f - 1) / f, (g.nz + f - 1) / f};
+  nAgg = coarse.nx * coarse.ny * coarse.nz;
+  std::vector<lid_t> agg(static_cast<std::size_t>(g.nx) * g.ny * g.nz);
+  for (lid_t z = 0, i = 0; z < g.nz; ++z)
+    for (lid_t y = 0; y < g.ny; ++y)
+      for (lid_t x = 0; x < g.nx; ++x, ++i) agg[i] = x / f + coarse.nx * (y / f + coarse.ny * (z / f));
+  return agg;
+}
+
 /// Transpose of a sparsity (columns come out sorted); map(t) = position in the original of
 /// transposed entry t.
 void transpose(lid_t nRows, lid_t nCols, const std::vector<lid_t>& ptr, const std::vector<lid_t>& idx,
@@ -341,13 +416,25 @@ double estimateLambdaMax(const ExecSpace& exec, const CsrMatrix& A, const ConstR
 //  - a square ELL operator whose rows repeat a few column patterns relative to the row (a
 //    structured block: 27 patterns) stores a one-byte pattern id per row instead of its column
 //    indices: 25 instead of 48 bytes per finest row and pass, which matters where the finest
-//    level streams from DRAM (128^3).
+//    level streams from DRAM (128^3);
+//  - boundary rows of such an operator take the interior pattern where it holds their columns
+//    (adoptDominantPattern), so host runs span planes, not lines; the level-1 operator of lattice
+//    cubes (32 off-diagonals) is swept in chunks of 8 terms per vectorised pass (RunRows). 64^3
+//    cavity, one thread: level-1 smoothing and residuals 10 ms per step (the greedy CSR level 1:
+//    ~39 ms); the finest level's smoother pass ~0.35 instead of ~0.44 ms (runs over planes).
 // ---------------------------------------------------------------------------------------------
 
 /// Widths with an ELL kernel; a row set whose longest row fits one of them, padded by at most
-/// kEllMaxPadding entries per row on average, is stored as ELL, otherwise as CSR.
-constexpr int kEllWidths[] = {4, 6, 8};
-constexpr double kEllMaxPadding = 3.0;
+/// ellMaxPadding(w) entries per row on average, is stored as ELL, otherwise as CSR.
+/// 4-8: the finest level of a hex mesh and prolongators; 12 and 32: the off-diagonals of an
+/// interior row of the level below a 2D / 3D lattice aggregated into squares / cubes (3 x 3
+/// (x 3) neighbouring aggregates and two more along each axis, minus the diagonal), and their
+/// restriction rows (an aggregate and the face layer around it: 4 + 8 / 8 + 24).
+constexpr int kEllWidths[] = {4, 6, 8, 12, 32};
+/// Largest mean padding per row of an ELL layout of width w: 3 entries, or w / 4 for the wide
+/// lattice-level widths (boundary rows of a small coarse lattice are up to ~30 % shorter: 8^3;
+/// padding costs zeros read in a vectorised sweep, CSR a branch and a column index per entry).
+constexpr double ellMaxPadding(int w) { return w / 3 > 3 ? w / 3 : 3.0; }
 /// Most distinct column patterns of a pattern-compressed ELL operator (one-byte ids).
 constexpr std::size_t kMaxPatterns = 256;
 /// Longest run of a pattern-compressed operator: bounds a host thread's unit of work.
@@ -355,6 +442,9 @@ constexpr lid_t kMaxRun = 1024;
 /// Host backends sweep pattern-compressed operators run by run (vectorisable); device backends
 /// row by row (one thread per row, coalesced).
 constexpr bool kRunSweeps = kHostExec;
+/// Widest pattern whose run sweep keeps all its terms in one loop over rows (RunRows); wider
+/// patterns are swept a chunk of 8 (or 6) terms per pass.
+constexpr int kRunUnrolled = 8;
 
 template <class S>
 using WorkView = Kokkos::View<S*, MemSpace>;
@@ -407,11 +497,49 @@ struct AmgCycleLevel {
   /// right-hand side D^{-1} b (unscaled on a dense coarsest level); r: scaled residual;
   /// d: Chebyshev direction.
   Kokkos::View<S*, MemSpace> x, y, e, b, r, d;
+  /// Kernel labels mfsi::kernels::amg::level<l>::{smoother, residual, restrict, prolong}: the
+  /// levels' costs differ by layout, so profiles tell them apart.
+  std::string smootherLabel, residualLabel, restrictLabel, prolongLabel;
 };
 
 }  // namespace detail
 
 namespace {
+
+/// Boundary rows of a lattice take the pattern of the interior rows (the most frequent one) where
+/// it holds all their columns and stays inside the rows: the missing couplings become explicit
+/// zeros (src -1), which ELL padding costs anyway. Why: runs of one pattern then span whole
+/// planes of the lattice (all but the first and last planes or two), instead of lines cut at
+/// every boundary row, and the run sweeps' per-run overhead is paid once per ~1000 rows rather than
+/// once per ~30 (level 1 of a 64^3 lattice: 28-row runs). The non-zero terms keep their order, so
+/// the sums are those of the exact patterns. `col`, `src`: row-major ELL (col: absolute columns).
+void adoptDominantPattern(lid_t n, int w, const std::vector<lid_t>& col, std::vector<lid_t>& src,
+                          const std::vector<lid_t>& offsets, std::vector<std::uint8_t>& rowPattern) {
+  std::vector<lid_t> count(offsets.size() / w, 0);
+  for (lid_t i = 0; i < n; ++i) ++count[rowPattern[i]];
+  const int d = static_cast<int>(std::max_element(count.begin(), count.end()) - count.begin());
+  const lid_t* od = offsets.data() + static_cast<std::size_t>(d) * w;
+  for (int k = 1; k < w; ++k)
+    if (od[k] <= od[k - 1]) return;  // the dominant pattern is padded itself: no interior
+  std::vector<lid_t> rowSrc(w);
+  for (lid_t i = 0; i < n; ++i) {
+    if (rowPattern[i] == d || i + od[0] < 0 || i + od[w - 1] >= n) continue;
+    const std::size_t at = static_cast<std::size_t>(i) * w;
+    // Both sorted: merge the row's entries (padding has src -1) into the dominant offsets.
+    int kd = 0;
+    bool covered = true;
+    std::fill(rowSrc.begin(), rowSrc.end(), -1);
+    for (int k = 0; k < w && covered; ++k) {
+      if (src[at + k] < 0) continue;
+      while (kd < w && i + od[kd] < col[at + k]) ++kd;
+      covered = kd < w && i + od[kd] == col[at + k];
+      if (covered) rowSrc[kd++] = src[at + k];
+    }
+    if (!covered) continue;
+    std::copy(rowSrc.begin(), rowSrc.end(), src.begin() + at);
+    rowPattern[i] = static_cast<std::uint8_t>(d);
+  }
+}
 
 /// Host-side choice of layout for the entries of M kept in a cycle operator.
 template <class S>
@@ -428,7 +556,7 @@ detail::AmgCycleOp<S> buildCycleOp(const CsrMatrix& M, bool dropDiagonal, const 
     longest = std::max(longest, len);
   }
   for (int w : kEllWidths)
-    if (longest <= w && static_cast<double>(w) * n <= kept + kEllMaxPadding * n) {
+    if (longest <= w && static_cast<double>(w) * n <= kept + ellMaxPadding(w) * n) {
       op.width = w;
       break;
     }
@@ -484,6 +612,7 @@ detail::AmgCycleOp<S> buildCycleOp(const CsrMatrix& M, bool dropDiagonal, const 
       rowPattern[i] = static_cast<std::uint8_t>(id);
     }
     if (ids.size() <= kMaxPatterns) {
+      adoptDominantPattern(n, op.width, col, src, offsets, rowPattern);
       op.pattern = toDevice(rowPattern, label + "::pattern");
       op.offsets = toDevice(offsets, label + "::offsets");
       col.clear();
@@ -595,6 +724,10 @@ void byLayout(const detail::AmgCycleOp<S>& op, const F& f) {
       return pat ? f(Layout<6, true>()) : f(Layout<6, false>());
     case 8:
       return pat ? f(Layout<8, true>()) : f(Layout<8, false>());
+    case 12:
+      return pat ? f(Layout<12, true>()) : f(Layout<12, false>());
+    case 32:
+      return pat ? f(Layout<32, true>()) : f(Layout<32, false>());
     default:
       return f(Layout<0, false>());
   }
@@ -623,6 +756,35 @@ struct RunRows {
   void forRows(lid_t r, const S* x, const Row& row) const {
     const lid_t i0 = runStart[r], i1 = runStart[r + 1];
     const lid_t* o = offsets + static_cast<lid_t>(runPattern[r]) * W;
+    if constexpr (W > kRunUnrolled) {
+      // Wide rows (lattice coarse levels): 2 W streams do not fit in registers, and a loop over
+      // them inside the loop over rows does not vectorise. Instead the run's partial sums go
+      // through an accumulator in L1, kRunChunk terms per vectorised pass (the same sums in the
+      // same order). Measured best: 8 terms per pass for W = 32 (64^3 Poisson AMG-CG, one
+      // thread: 7.8 ms per iteration; 4 terms: 9.1 ms, 16: 8.8 ms), 6 for W = 12 (512^2: 7.4 ms
+      // per iteration; 4 terms: 8.0 ms, 12: 7.7 ms).
+      constexpr int kRunChunk = W % 8 == 0 ? 8 : 6;
+      static_assert(W % kRunChunk == 0, "wide run widths are multiples of the chunk");
+      S acc[kMaxRun];
+      const lid_t m = i1 - i0;
+      for (lid_t j = 0; j < m; ++j) acc[j] = 0;
+      for (int k0 = 0; k0 < W; k0 += kRunChunk) {
+        const S* xk[kRunChunk];
+        const S* vk[kRunChunk];
+        for (int k = 0; k < kRunChunk; ++k) {
+          xk[k] = x + o[k0 + k] + i0;
+          vk[k] = val + static_cast<std::size_t>(k0 + k) * n + i0;
+        }
+        MFSI_IVDEP
+        for (lid_t j = 0; j < m; ++j) {
+          S s = acc[j];
+          for (int k = 0; k < kRunChunk; ++k) s += vk[k][j] * xk[k][j];
+          acc[j] = s;
+        }
+      }
+      for (lid_t j = 0; j < m; ++j) row(i0 + j, acc[j]);
+      return;
+    }
     const S* xk[W];
     const S* vk[W];
     for (int k = 0; k < W; ++k) {
@@ -785,6 +947,7 @@ struct detail::AmgHierarchy {
     CsrMatrix AP;  ///< A P, kept for the value updates of the Galerkin product R (A P)
     IndexView rToP;
     IndexView agg;
+    AmgLattice lattice;  ///< this level's lattice when it is aggregated into cubes
     RealView invDiag;
     double lambdaMax = 0.0;
     std::vector<Step> steps;        ///< `sweeps` smoother sweeps (pre- and post-smoothing)
@@ -926,6 +1089,11 @@ void buildCycle(const ExecSpace& exec, const detail::AmgHierarchy& h, std::vecto
     const lid_t n = L.A.nRows;
     const std::string pre = "mfsi::kernels::amg::level" + std::to_string(l) + "::cycle::";
     C.A = buildCycleOp<S>(L.A, true, pre + "A");
+    const std::string kernel = "mfsi::kernels::amg::level" + std::to_string(l) + "::";
+    C.smootherLabel = kernel + "smoother";
+    C.residualLabel = kernel + "residual";
+    C.restrictLabel = kernel + "restrict";
+    C.prolongLabel = kernel + "prolong";
     if (l + 1 < h.levels.size()) {
       C.P = buildCycleOp<S>(L.P, false, pre + "P");
       C.R = buildCycleOp<S>(L.R, false, pre + "R");
@@ -991,9 +1159,23 @@ void AmgPreconditioner::setup(const ExecSpace& exec, const CsrMatrix& A) {
     exec.fence();
     const HostCsr a = hostCopy(lv[l].A);
     lid_t nc = 0;
-    const std::vector<lid_t> agg = aggregate(a, l == 0 ? options_.strengthThreshold : 0.0, nc);
-    // Stop when coarsening stalls (e.g. no couplings left): the coarsest level takes over.
-    if (nc == 0 || nc > n - n / 8) break;
+    std::vector<lid_t> agg;
+    const bool cubes = options_.aggregation == AmgAggregation::Auto && static_cast<int>(l) < options_.latticeLevels;
+    if (cubes && l == 0) {
+      lv[0].lattice = latticeOf(a);
+      if (lv[0].lattice.valid() && !allStrong(a, options_.strengthThreshold)) lv[0].lattice = {};
+    }
+    if (!cubes) lv[l].lattice = {};  // kept only on levels aggregated into cubes
+    AmgLattice coarseLattice;
+    if (lv[l].lattice.valid())
+      agg = latticeAggregates(lv[l].lattice, coarseLattice, nc, l == 0 ? 2 : 3);
+    else
+      agg = aggregate(a, l == 0 ? options_.strengthThreshold : 0.0, nc);
+    // Stop when coarsening stalls (e.g. no couplings left): the coarsest level takes over. Also
+    // rather than coarsen a level that is solved directly anyway into a single aggregate: on a
+    // singular (Neumann) system its 1 x 1 operator is the null space's rounding left-over, which
+    // the relative cut of the pseudo-inverse cannot tell from a true eigenvalue.
+    if (nc == 0 || nc > n - n / 8 || (nc == 1 && n <= options_.maxDirectSize)) break;
 
     // Prolongator sparsity: smoothed P couples row i with the aggregates of its matrix neighbours.
     std::vector<lid_t> pPtr(n + 1, 0), pIdx, row;
@@ -1022,6 +1204,7 @@ void AmgPreconditioner::setup(const ExecSpace& exec, const CsrMatrix& A) {
     lv[l].rToP = toDevice(rToP, pre + "::rToP");
     lv[l].AP = makeCsr(n, nc, apPtr, apIdx, pre + "::AP");
     Level next;
+    next.lattice = coarseLattice;
     next.A = makeCsr(nc, nc, cPtr, cIdx, "mfsi::kernels::amg::level" + std::to_string(l + 1) + "::A");
     lv.push_back(next);
     levelTransferValues(exec, lv[l], lv[l + 1], options_);
@@ -1080,7 +1263,7 @@ WorkView<S> runSteps(const ExecSpace& exec, const detail::AmgCycleLevel<S>& C, c
         const RangePolicy runs(exec, 0, C.A.nRuns);
         auto sweep = [&](auto* xOut, auto readTag, auto writeTag) {
           using T = std::remove_pointer_t<decltype(xOut)>;
-          Kokkos::parallel_for("mfsi::kernels::amg::smoother", runs,
+          Kokkos::parallel_for(C.smootherLabel, runs,
                                SmootherRunKernel<S, L::width, T, decltype(readTag)::value, decltype(writeTag)::value>{
                                    RunRows<S, L::width>(C.A), C.b.data(), cur.data(), dIn.data(), xOut,
                                    dOut.data(), c1, c2});
@@ -1100,11 +1283,11 @@ WorkView<S> runSteps(const ExecSpace& exec, const detail::AmgCycleLevel<S>& C, c
       const RangePolicy policy(exec, 0, C.A.nRows);
       if (last && toOut)
         Kokkos::parallel_for(
-            "mfsi::kernels::amg::smoother", policy,
+            C.smootherLabel, policy,
             SmootherStepKernel<S, L, Out>{OpRows<S, L>(C.A), C.b, cur, dIn, out, dOut, c1, c2, readD, writeD});
       else
         Kokkos::parallel_for(
-            "mfsi::kernels::amg::smoother", policy,
+            C.smootherLabel, policy,
             SmootherStepKernel<S, L, WorkView<S>>{OpRows<S, L>(C.A), C.b, cur, dIn, next, dOut, c1, c2, readD, writeD});
     });
     if (last && toOut) return cur;
@@ -1131,10 +1314,10 @@ void vcycle(const ExecSpace& exec, const detail::AmgHierarchy& h, const std::vec
   byLayout(C.A, [&](auto layout) {
     using L = decltype(layout);
     if constexpr (L::patterned && kRunSweeps)
-      Kokkos::parallel_for("mfsi::kernels::amg::residual", RangePolicy(exec, 0, C.A.nRuns),
+      Kokkos::parallel_for(C.residualLabel, RangePolicy(exec, 0, C.A.nRuns),
                            ResidualRunKernel<S, L::width>{RunRows<S, L::width>(C.A), C.b.data(), x.data(), C.r.data()});
     else
-      Kokkos::parallel_for("mfsi::kernels::amg::residual", RangePolicy(exec, 0, C.A.nRows),
+      Kokkos::parallel_for(C.residualLabel, RangePolicy(exec, 0, C.A.nRows),
                            ResidualKernel<S, L>{OpRows<S, L>(C.A), C.b, x, C.r});
   });
   const auto& N = cycle[l + 1];
@@ -1143,7 +1326,7 @@ void vcycle(const ExecSpace& exec, const detail::AmgHierarchy& h, const std::vec
   const double c = nextDirect ? 0.0 : (l + 2 == h.levels.size() ? LN.coarseSteps : LN.steps)[0].c2;
   byLayout(C.R, [&](auto layout) {
     using L = decltype(layout);
-    Kokkos::parallel_for("mfsi::kernels::amg::restrict", RangePolicy(exec, 0, C.R.nRows),
+    Kokkos::parallel_for(C.restrictLabel, RangePolicy(exec, 0, C.R.nRows),
                          RestrictKernel<S, L>{OpRows<S, L>(C.R), C.r, N.b, N.x, static_cast<S>(c), !nextDirect});
   });
   if (nextDirect)
@@ -1152,7 +1335,7 @@ void vcycle(const ExecSpace& exec, const detail::AmgHierarchy& h, const std::vec
     vcycle<S>(exec, h, cycle, l + 1, N.e);
   byLayout(C.P, [&](auto layout) {
     using L = decltype(layout);
-    Kokkos::parallel_for("mfsi::kernels::amg::prolong", RangePolicy(exec, 0, C.P.nRows),
+    Kokkos::parallel_for(C.prolongLabel, RangePolicy(exec, 0, C.P.nRows),
                          ProlongKernel<S, L>{OpRows<S, L>(C.P), N.e, x});
   });
   runSteps<S>(exec, C, L.steps, 0, x, C.d, out, true);
@@ -1197,15 +1380,36 @@ AmgInfo AmgPreconditioner::info() const {
   AmgInfo out;
   if (!h_) return out;
   double nnz = 0, rows = 0;
+  auto cycleLayouts = [&](const auto& cycle) {
+    for (std::size_t l = 0; l < cycle.size() && l < out.levels.size(); ++l) {
+      out.levels[l].cycleWidth = cycle[l].A.width;
+      out.levels[l].cyclePatterned = cycle[l].A.pattern.extent(0) > 0;
+    }
+  };
   for (const auto& L : h_->levels) {
-    out.levels.push_back({L.A.nRows, L.A.nnz(), L.lambdaMax});
+    AmgLevelInfo li;
+    li.rows = L.A.nRows;
+    li.nnz = L.A.nnz();
+    li.lambdaMax = L.lambdaMax;
+    if (L.agg.extent(0) > 0) li.lattice = L.lattice;
+    out.levels.push_back(li);
     nnz += L.A.nnz();
     rows += L.A.nRows;
   }
+  if (options_.precision == AmgPrecision::Double)
+    cycleLayouts(h_->cycleDouble);
+  else
+    cycleLayouts(h_->cycleMixed);
   out.operatorComplexity = nnz / h_->levels[0].A.nnz();
   out.gridComplexity = rows / h_->levels[0].A.nRows;
   out.directCoarseSolve = h_->direct;
   return out;
+}
+
+AmgLattice detectLattice(const CsrMatrix& A) {
+  if (A.nRows != A.nCols) return {};
+  Kokkos::fence();
+  return latticeOf(hostCopy(A));
 }
 
 }  // namespace mfsi

@@ -8,6 +8,11 @@
 ///    greedy three-phase aggregation
 ///    (roots whose strong neighbours are all free take them; leftovers join the strongest
 ///    neighbouring aggregate; the rest form new aggregates). Host, set-up only.
+///  - on a structured lattice (one block numbered x fastest, 7- or 5-point, every coupling
+///    strong: `detectLattice`), lattice-aligned cubes instead (`AmgAggregation`): 2x2x2 on the
+///    finest level, 3x3x3 below, numbered lexicographically, so every level is a lattice
+///    operator with a few column patterns; level 1 (33 points) is stored pattern-compressed and
+///    swept in long vectorised runs, where greedy aggregates give an irregular ~30-point CSR.
 ///  - tentative prolongator: piecewise constant on aggregates (it carries the constant null space);
 ///    smoothed prolongator P = (I - omega D^{-1} A) P_tent with omega = 4/3 / lambda_max(D^{-1} A)
 ///    (`AmgProlongation::Unsmoothed` keeps P_tent; it converges poorly and is there for comparison).
@@ -29,13 +34,20 @@
 /// preconditioner far below what CG notices: the iteration counts are those of the double cycle.
 ///
 /// Measured (tests/kernels/test_amg.cpp, 7-point Dirichlet Poisson, rough right-hand side, CG to
-/// 1e-8): 7 / 7 / 8 iterations at 16^3, 24^3 and 32^3 with the default degree-3 Chebyshev
-/// smoother (degree 2: 9 / 9 / 9; Jacobi-CG: 59, 86, 116); operator complexity 1.5.
-/// perf/bench_linsolve PressureSolve (same problem): 8 / 9 / 10 iterations at 32^3 / 64^3 /
-/// 128^3 in both precisions (degree 2: 9 / 10 / 12). Per CG iteration on one thread, float cycle
-/// vs double cycle: 64^3 11.5 vs 17.1 ms, 128^3 97 vs 133 ms (perf/RESULTS.md); the degree-2
-/// double CSR cycle the float cycle replaced took 18.0 / 152 ms. At 32^3 (cache-resident) the
-/// kernels are bound by instructions, not bytes, and float gains little (1.1-1.2x).
+/// 1e-8): 7 / 8 / 8 iterations at 16^3, 24^3 and 32^3 with the default degree-3 Chebyshev
+/// smoother and lattice cubes (greedy aggregation: 7 / 7 / 8; degree 2: 9 / 9 / 9; Jacobi-CG:
+/// 59, 86, 116); operator complexity 1.5-1.6.
+/// perf/bench_linsolve PressureSolve (same problem), greedy aggregation: 8 / 9 / 10 iterations at
+/// 32^3 / 64^3 / 128^3 in both precisions (degree 2: 9 / 10 / 12). Per CG iteration on one
+/// thread, float cycle vs double cycle: 64^3 11.5 vs 17.1 ms, 128^3 97 vs 133 ms
+/// (perf/RESULTS.md); the degree-2 double CSR cycle the float cycle replaced took 18.0 / 152 ms.
+/// At 32^3 (cache-resident) the kernels are bound by instructions, not bytes, and float gains
+/// little (1.1-1.2x). Lattice cubes vs greedy aggregation (float cycle, one thread, CPU time of
+/// one session on a shared machine): 8 / 9 / 9 vs 8 / 9 / 10 iterations, 0.94 / 8.2 / 73 vs
+/// 1.18 / 11.0 / 93 ms per iteration at 32^3 / 64^3 / 128^3; 3D cavity at 64^3
+/// (perf/bench_cavity3d): 7.5 vs 8.5 AMG-CG iterations per step, V-cycles 40 vs 75 ms per step.
+/// One cell thick (512^2, Neumann): 7 vs 8 iterations at ~7.4 vs ~6.5 ms per iteration (the
+/// 13-point level 1 is heavy next to a 5-point finest level): about the same time per solve.
 ///
 /// Singular (pure Neumann) systems: aggregation keeps the constant vector in the range of every P,
 /// so every coarse operator has the same null space, and the coarsest solve is a pseudo-inverse
@@ -61,6 +73,14 @@ struct AmgHierarchy;
 }  // namespace detail
 
 enum class AmgProlongation { Smoothed, Unsmoothed };
+/// \brief Aggregation of the levels. Auto: when the finest matrix is a structured lattice
+/// (`detectLattice`) whose couplings are all strong, the first `latticeLevels` levels are
+/// aggregated into lattice-aligned cubes numbered lexicographically (2x2x2 on the finest level,
+/// 3x3x3 below; squares on a one-cell-thick lattice), so every coarse operator is again a
+/// lattice operator whose rows share a few column patterns (level 1: stored pattern-compressed,
+/// swept vectorised on host backends); other levels, and every other matrix (unstructured,
+/// multi-block, anisotropic), are aggregated greedily. Greedy: greedy everywhere.
+enum class AmgAggregation { Auto, Greedy };
 enum class AmgSmoother { Chebyshev, Jacobi };
 /// \brief Arithmetic of the V-cycle. Mixed: every level's operator, P, R and diagonal are float
 /// copies and the cycle runs in float (apply()'s r and z stay double; the coarsest dense solve
@@ -94,13 +114,33 @@ struct AmgOptions {
   int maxLevels = 12;
   lid_t maxDirectSize = 2000;                    ///< largest coarsest level solved densely; above: 10 smoother sweeps
   AmgPrecision precision = AmgPrecision::Mixed;  ///< arithmetic of the V-cycle
+  AmgAggregation aggregation = AmgAggregation::Auto;
+  /// Levels aggregated into lattice cubes under AmgAggregation::Auto, from the finest down (the
+  /// default: all of them; 1: the finest only, greedy below).
+  int latticeLevels = 12;
 };
+
+/// \brief Extents of a structured lattice: nx * ny * nz rows numbered x fastest. Empty (all 0)
+/// when a matrix is not one.
+struct AmgLattice {
+  lid_t nx = 0, ny = 0, nz = 0;
+  bool valid() const { return nx > 0; }
+};
+
+/// \brief The lattice of a square matrix whose every row i = x + nx (y + ny z) holds exactly its
+/// diagonal and its in-range lattice neighbours i -+ 1, i -+ nx, i -+ nx ny (a 7-point stencil;
+/// 5-point with nz = 1), or an empty AmgLattice: other numberings, wrap-around or extra couplings,
+/// missing couplings, several blocks, 1D chains. Every row is checked (host, set-up cost).
+AmgLattice detectLattice(const CsrMatrix& A);
 
 /// \brief One level of the hierarchy, for logs and tests.
 struct AmgLevelInfo {
   lid_t rows = 0;
   lid_t nnz = 0;
   real lambdaMax = 0.0;  ///< estimated largest eigenvalue of D^{-1} A
+  int cycleWidth = 0;      ///< ELL width of the cycle's copy of the operator (0: CSR)
+  bool cyclePatterned = false;  ///< the cycle's copy stores column patterns, not columns
+  AmgLattice lattice;      ///< set when this level was aggregated into lattice cubes
 };
 
 /// \brief Hierarchy summary.
