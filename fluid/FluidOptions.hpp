@@ -169,9 +169,11 @@ struct FluidOptions {
   ReductionMode reduction = ReductionMode::Gather;
   /// Use the fused per-cell passes where valid: momentum matrix and source (orthogonal mesh, linear
   /// or upwind convection, Gather reduction), pressure matrix and end-of-step pass (Gather),
-  /// pressure source flux without phiHbyA (orthogonal mesh). They give the same fields bitwise as
-  /// the face-coefficient paths; false forces those paths (verification, perf comparison). Not a
-  /// scene key.
+  /// pressure source flux without phiHbyA (orthogonal mesh), pressure gradient with its boundary
+  /// pressures in one pass (Gather, Gauss linear), final face fluxes with the correction fluxes;
+  /// and skip the face fluxes of correctors that the next one overwrites unread. They give the
+  /// same fields bitwise as the face-coefficient paths; false forces those paths (verification,
+  /// perf comparison). Not a scene key.
   bool fusedMomentumAssembly = true;
   PimpleOptions pimple;
   LinearSolverOptions momentumSolver{1e-10, 0.0, 1000};

@@ -23,13 +23,90 @@ KOKKOS_INLINE_FUNCTION real limiter(ConvectionScheme s, real r) {
 /// Rhie-Chow correction flux of internal face f (owner o, neighbour n) stored for the next step:
 /// phi_f minus the flux of the linearly interpolated cell velocities. storeDdtCorrection and the
 /// fused finishStep share it.
-KOKKOS_INLINE_FUNCTION real ddtCorrectionFlux(lid_t f, lid_t o, lid_t n, const ConstRealView& w,
-                                              const ConstRealView& phi, const ConstReal3View& U,
-                                              const ConstReal3View& sf) {
+KOKKOS_INLINE_FUNCTION real ddtCorrectionFlux(lid_t f, lid_t o, lid_t n, const ConstRealView& w, real phi,
+                                              const ConstReal3View& U, const ConstReal3View& sf) {
   real s = 0;
   for (int k = 0; k < 3; ++k) s += (w(f) * U(o, k) + (1.0 - w(f)) * U(n, k)) * sf(f, k);
-  return phi(f) - s;
+  return phi - s;
 }
+
+/// Face flux of internal face f (owner o, neighbour n) from the solved pressure: the source flux
+/// `fl` minus the implicit part of the pressure-gradient flux. The pressure::flux kernel and the
+/// end-of-step flux pass share it.
+KOKKOS_INLINE_FUNCTION real correctedFlux(lid_t f, lid_t o, lid_t n, const ConstRealView& w, const ConstRealView& rAU,
+                                          const ConstRealView& dc, const ConstRealView& fl, const ConstRealView& p) {
+  const real rAUf = w(f) * rAU(o) + (1.0 - w(f)) * rAU(n);
+  return fl(f) - rAUf * dc(f) * (p(n) - p(o));
+}
+
+/// Pressure on boundary face b (face f, owner o with pressure po and gradient go): prescribed on
+/// fixed-pressure faces, the owner's value on empty faces (and everywhere without extrapolation),
+/// otherwise extrapolated from the owner with its gradient. updateBoundaryPressure and the fused
+/// gradient pass share it.
+KOKKOS_INLINE_FUNCTION real boundaryFacePressure(lid_t b, lid_t f, lid_t o, real po, const real go[3], bool extrapolate,
+                                                 const ConstIndexView& kind, const ConstRealView& bp,
+                                                 const ConstReal3View& fc, const ConstReal3View& cc) {
+  const int kd = kind(b);
+  if (kd == kFacePressure) return bp(b);
+  if (kd == kFaceEmpty || !extrapolate) return po;
+  real s = po;
+  for (int k = 0; k < 3; ++k) s += go[k] * (fc(f, k) - cc(o, k));
+  return s;
+}
+
+/// One cell of the fused FluidSolver::updatePressureGradient: the pressures of the cell's boundary
+/// faces and its Gauss-linear gradient through the stencil (the formula of the gaussStencil kernel).
+///
+/// Why one pass is exact: a boundary face's pressure depends on its owner's p and gradient alone,
+/// and a cell's gradient reads the pressures of its own boundary faces alone. So the sequence of
+/// updatePressureGradient (boundary pressures from the previous gradient, gradient, with
+/// extrapolated wall pressures boundary pressures again from that gradient and the gradient of
+/// the boundary cells again) is, per cell, a second sweep over the cell's own stencil right after
+/// the first (its data still in cache), with the same operations in the same order: the same bits
+/// without the separate boundary-pressure kernels and the pass over the scattered boundary cells.
+/// (Forming U = HbyA - rAU grad p in this pass too was measured no faster than the separate
+/// streaming correction pass, which finds grad p still in cache.)
+struct PressureGradientKernel {
+  lid_t nIn = 0;
+  bool extrapolate = false;  ///< extrapolated wall pressures (see updatePressureGradient)
+  ConstIndexView off, other, kind;
+  ConstReal3View self, coef, fc, cc;
+  ConstRealView p, bp;
+  RealView pb;
+  Real3View gp;
+
+  /// Gradient g of p at cell c, its boundary faces extrapolating with gradient `gb` (stored in pb
+  /// with `store`). Returns whether c has a boundary face.
+  KOKKOS_FORCEINLINE_FUNCTION bool gradient(lid_t c, real pc, const real gb[3], real g[3], bool store) const {
+    bool boundary = false;
+    for (int d = 0; d < 3; ++d) g[d] = self(c, d) * pc;
+    for (lid_t e = off(c); e < off(c + 1); ++e) {
+      const lid_t o = other(e);
+      real v;
+      if (o >= 0) {
+        v = p(o);
+      } else {
+        const lid_t b = -o - 1;
+        v = boundaryFacePressure(b, b + nIn, c, pc, gb, extrapolate, kind, bp, fc, cc);
+        if (store) pb(b) = v;
+        boundary = true;
+      }
+      for (int d = 0; d < 3; ++d) g[d] += coef(e, d) * v;
+    }
+    return boundary;
+  }
+
+  KOKKOS_FORCEINLINE_FUNCTION void operator()(lid_t c) const {
+    const real pc = p(c);
+    const real g0[3] = {gp(c, 0), gp(c, 1), gp(c, 2)};
+    real g[3];
+    if (gradient(c, pc, g0, g, /*store=*/!extrapolate) && extrapolate) {
+      const real g1[3] = {g[0], g[1], g[2]};
+      gradient(c, pc, g1, g, /*store=*/true);
+    }
+    for (int d = 0; d < 3; ++d) gp(c, d) = g[d];
+  }
+};
 
 /// Sum of |U| and |p| of a cell: summed over the cells it is finite iff every field value is.
 KOKKOS_INLINE_FUNCTION real fieldMagnitude(lid_t c, const ConstReal3View& U, const ConstRealView& p) {
@@ -54,7 +131,7 @@ struct MomentumRowKernel {
   ConstIndexView off, cf, own, cfp, rowPtr, di, kind;
   ConstRealView phi, mp, w, dc, V, V0, V00;
   ConstReal3View U, U0, U00, Ub;
-  RealView vals, diagU;
+  RealView vals;
   Real3View rhs;
   bool withB = false;  ///< also the momentum solve's right-hand side b = rhs - V grad p
   ConstReal3View gp;
@@ -115,7 +192,6 @@ struct MomentumRowKernel {
     // Implicit under-relaxation: a_P -> a_P / alpha, source += (a_P / alpha - a_P) u_prev.
     const real ar = diag / alpha;
     vals(di(c)) = ar;
-    diagU(c) = ar;
     for (int j = 0; j < 3; ++j) {
       const real r = (src[j] + -1.0 * bsum[j]) + (ar - diag) * U(c, j);
       rhs(c, j) = r;
@@ -185,10 +261,8 @@ FluidSolver::FluidSolver(const HexMesh& mesh, const FluidOptions& options)
   HbyA_ = Real3View("mfsi::fluid::HbyA", nCells_);
   gradP_ = Real3View("mfsi::fluid::gradP", nCells_);
   rhsU_ = Real3View("mfsi::fluid::momentum::rhs", nCells_);
-  bodyU_ = Real3View("mfsi::fluid::momentum::source", nCells_);
   gradU_ = Tensor3View("mfsi::fluid::gradU", nCells_);
   rAU_ = RealView("mfsi::fluid::rAU", nCells_);
-  diagU_ = RealView("mfsi::fluid::momentum::diag", nCells_);
   cellDiag_ = RealView("mfsi::fluid::cellDiag", nCells_);
   rhsP_ = RealView("mfsi::fluid::pressure::rhs", nCells_);
   b_ = RealView("mfsi::fluid::solveB", nCells_);
@@ -470,21 +544,18 @@ void FluidSolver::updateBoundaryPressure() {
   Kokkos::parallel_for(
       "mfsi::fluid::bc::pressure", RangePolicy(exec_, 0, nB_), KOKKOS_LAMBDA(lid_t b) {
         const lid_t f = b + nIn, o = own(f);
-        const int kd = kind(b);
-        if (kd == kFacePressure) {
-          pb(b) = bp(b);
-        } else if (kd == kFaceEmpty || !extrapolate) {
-          pb(b) = p(o);
-        } else {
-          real s = p(o);
-          for (int k = 0; k < 3; ++k) s += gp(o, k) * (fc(f, k) - cc(o, k));
-          pb(b) = s;
-        }
+        const real go[3] = {gp(o, 0), gp(o, 1), gp(o, 2)};
+        pb(b) = boundaryFacePressure(b, f, o, p(o), go, extrapolate, kind, bp, fc, cc);
       });
 }
 
 void FluidSolver::updatePressureGradient() {
   if (gradPValid_) return;
+  if (fusedCellPasses() && opt_.gradient == GradientScheme::GaussLinear) {
+    pressureGradientFused();
+    gradPValid_ = true;
+    return;
+  }
   // The extrapolated wall values depend on the gradient they feed; two passes contract the lag by
   // a factor of four (each pass halves it) and the outer iterations converge it. Boundary values
   // that do not depend on the gradient need one pass.
@@ -497,6 +568,26 @@ void FluidSolver::updatePressureGradient() {
     pressureGradient(boundaryCells_);
   }
   gradPValid_ = true;
+}
+
+void FluidSolver::pressureGradientFused() {
+  // The boundary pressures and the gradient (with extrapolated wall pressures both twice) in one
+  // pass over the cells: see PressureGradientKernel.
+  PressureGradientKernel k;
+  k.nIn = nIn_;
+  k.extrapolate = opt_.wallPressure == WallPressure::Extrapolated;
+  k.off = mesh_.cellFaceOffsets();
+  k.other = gradStencil_.other;
+  k.kind = bc_.kind();
+  k.self = gradStencil_.self;
+  k.coef = gradStencil_.coef;
+  k.fc = geo_.faceCentroid;
+  k.cc = geo_.cellCentroid;
+  k.p = p_;
+  k.bp = bc_.pressure();
+  k.pb = pb_;
+  k.gp = gradP_;
+  Kokkos::parallel_for("mfsi::fluid::pressure::gradient", RangePolicy(exec_, 0, nCells_), k);
 }
 
 void FluidSolver::pressureGradient(const ConstIndexView& cells) {
@@ -646,13 +737,11 @@ bool FluidSolver::assembleMomentum(bool withB) {
   const real alpha = opt_.pimple.relaxVelocity;
   ConstIndexView di = Au_.diagIdx;
   auto vals = Au_.values;
-  auto diag = diagU_;
   Kokkos::parallel_for(
       "mfsi::fluid::momentum::relax", RangePolicy(exec_, 0, nCells_), KOKKOS_LAMBDA(lid_t c) {
         const real a = vals(di(c));
         const real ar = a / alpha;
         vals(di(c)) = ar;
-        diag(c) = ar;
         for (int j = 0; j < 3; ++j) rhs(c, j) += (ar - a) * U(c, j);
       });
   return false;
@@ -702,7 +791,6 @@ void FluidSolver::assembleMomentumFused(bool withB) {
   k.U00 = U00_;
   k.Ub = Ub_;
   k.vals = Au_.values;
-  k.diagU = diagU_;
   k.rhs = rhsU_;
   k.withB = withB;
   k.gp = gradP_;
@@ -713,8 +801,8 @@ void FluidSolver::assembleMomentumFused(bool withB) {
 void FluidSolver::computeHbyA(bool withRAU) {
   // H = b - sum_N a_PN u_N (all but the pressure gradient); u = HbyA - rAU grad p, rAU = V / a_P.
   // a_P is read from the row being traversed (both assembly paths store the relaxed diagonal
-  // there and in diagU_: the same value). rAU depends on a_P alone: the same for every corrector
-  // of an outer iteration, so only the first one writes it.
+  // there). rAU depends on a_P alone: the same for every corrector of an outer iteration, so only
+  // the first one writes it.
   ConstIndexView rp = Au_.rowPtr, ci = Au_.colIdx, di = Au_.diagIdx;
   ConstRealView vals = Au_.values, V = geo_.cellVolume;
   ConstReal3View U = U_, rhs = rhsU_;
@@ -805,30 +893,24 @@ void FluidSolver::computePhiHbyA() {
       KOKKOS_LAMBDA(lid_t f) { phiH(f) = face(f); });
 }
 
-void FluidSolver::assemblePressureMatrix() {
-  ScopedRegion region("mfsi::fluid::pressure::assemble");
-  // The matrix depends on rAU and the geometry only: the same for every pressure corrector of one
-  // outer iteration, so it is assembled once per outer iteration (the source every corrector).
-  if (fusedCellPasses())
-    assemblePressureMatrixFused();
-  else
-    assemblePressureMatrixFaces();
-  if (pinsPressureLevel()) {
-    // No boundary sets the level: doubling one diagonal entry (and adding the matching source in
-    // assemblePressureSource) pins p at the reference cell without changing the other equations.
-    const lid_t ref = opt_.pressureReferenceCell;
-    ConstIndexView di = Ap_.diagIdx;
-    auto vals = Ap_.values;
-    Kokkos::parallel_for(
-        "mfsi::fluid::pressure::reference", RangePolicy(exec_, 0, 1),
-        KOKKOS_LAMBDA(lid_t) { vals(di(ref)) *= 2.0; });
-  }
+void FluidSolver::pinPressureLevel() {
+  // No boundary sets the level: doubling one diagonal entry (and adding the matching source in
+  // finishPressureSource) pins p at the reference cell without changing the other equations.
+  const lid_t ref = opt_.pressureReferenceCell;
+  ConstIndexView di = Ap_.diagIdx;
+  auto vals = Ap_.values;
+  Kokkos::parallel_for(
+      "mfsi::fluid::pressure::reference", RangePolicy(exec_, 0, 1), KOKKOS_LAMBDA(lid_t) { vals(di(ref)) *= 2.0; });
 }
 
-void FluidSolver::assemblePressureMatrixFused() {
+void FluidSolver::assemblePressureMatrixFused(bool stored) {
   // One thread per row, as assembleMatrix's gather, but computing each face coefficient where it
   // is needed instead of storing four per-face arrays and reading them back: the same values
-  // added in the same order (cell term, then the cell's faces in cellFaces() order).
+  // added in the same order (cell term, then the cell's faces in cellFaces() order). The same
+  // pass forms the source's divergence of the face fluxes (the divergence kernel's sum), sharing
+  // the walk over the cell's faces. With `stored` the face coefficients are read from coefP_
+  // (written by the source-flux pass, which has the interpolated rAU at hand) instead of formed
+  // from four face and two cell values: the same numbers.
   const lid_t nIn = nIn_;
   const bool comp = compressible();
   const real c = opt_.artificialCompressibility.soundSpeed;
@@ -836,23 +918,30 @@ void FluidSolver::assemblePressureMatrixFused() {
   ConstIndexView off = mesh_.cellFaceOffsets(), cf = mesh_.cellFaces(), own = mesh_.faceOwner(),
                  nei = mesh_.faceNeighbour();
   ConstIndexView cfp = sparsity_.cellFacePos, rowPtr = Ap_.rowPtr, di = Ap_.diagIdx, kind = bc_.kind();
-  ConstRealView w = fd_.weight, dc = fd_.deltaCoeff, rAU = rAU_, V = geo_.cellVolume;
+  ConstRealView w = fd_.weight, dc = fd_.deltaCoeff, rAU = rAU_, V = geo_.cellVolume, flux = fluxP_, cp = coefP_;
   auto vals = Ap_.values;
+  auto rhs = rhsP_;
   Kokkos::parallel_for(
       "mfsi::fluid::pressure::assembleFused", RangePolicy(exec_, 0, nCells_), KOKKOS_LAMBDA(lid_t cell) {
         for (lid_t e = rowPtr(cell); e < rowPtr(cell + 1); ++e) vals(e) = 0.0;
         real diag = comp ? k * c1 * V(cell) : 0.0;
+        real div = 0.0;
         for (lid_t e = off(cell); e < off(cell + 1); ++e) {
           const lid_t f = cf(e);
+          const lid_t o = own(f);
+          div += (o == cell ? 1.0 : -1.0) * flux(f);
           if (f < nIn) {
-            const real coef = pressureFaceCoefficient(f, own(f), nei(f), w, rAU, dc);
+            const real coef = stored ? cp(f) : pressureFaceCoefficient(f, o, nei(f), w, rAU, dc);
             diag += coef;
             vals(cfp(e)) += -coef;
+          } else if (stored) {
+            diag += cp(f);
           } else {
             diag += kind(f - nIn) == kFacePressure ? rAU(cell) * dc(f) : 0.0;
           }
         }
         vals(di(cell)) += diag;
+        rhs(cell) = -1.0 * div;
       });
 }
 
@@ -900,32 +989,53 @@ bool FluidSolver::fusedCellPasses() const {
   return opt_.fusedMomentumAssembly && opt_.reduction == ReductionMode::Gather;
 }
 
-void FluidSolver::pressureSourceFlux() {
-  // computePhiHbyA and the face loop of assemblePressureSource in one kernel, for orthogonal
+void FluidSolver::pressureSourceFlux(bool coefficients) {
+  // computePhiHbyA and the face loop of assemblePressure in one kernel, for orthogonal
   // meshes where the source flux of an internal face is phiHbyA itself (no non-orthogonal
-  // correction): no phiHbyA array written and read back. Same formulas, same bits.
+  // correction): no phiHbyA array written and read back. Same formulas, same bits. With
+  // `coefficients` it also stores each face's pressure-matrix coefficient for
+  // assemblePressureMatrixFused (the formulas of that kernel), from the face and cell values the
+  // flux has just read.
+  if (coefficients && coefP_.extent(0) == 0)
+    coefP_ = RealView(Kokkos::view_alloc(Kokkos::WithoutInitializing, "mfsi::fluid::pressure::faceCoefficient"),
+                      nFaces_);
   const PhiHbyAFace face = phiHbyAFace();
   const lid_t nIn = nIn_;
-  ConstIndexView own = mesh_.faceOwner(), kind = bc_.kind();
-  ConstRealView dc = fd_.deltaCoeff, rAU = rAU_, pb = pb_;
+  ConstIndexView own = mesh_.faceOwner(), nei = mesh_.faceNeighbour(), kind = bc_.kind();
+  ConstRealView w = fd_.weight, dc = fd_.deltaCoeff, rAU = rAU_, pb = pb_;
   auto flux = fluxP_;
+  auto cp = coefP_;
   Kokkos::parallel_for(
       "mfsi::fluid::pressure::phiHbyAFlux", RangePolicy(exec_, 0, nFaces_), KOKKOS_LAMBDA(lid_t f) {
         real s = face(f);
-        if (f >= nIn && kind(f - nIn) == kFacePressure) s -= rAU(own(f)) * dc(f) * pb(f - nIn);
+        const lid_t o = own(f);
+        const bool fixedP = f >= nIn && kind(f - nIn) == kFacePressure;
+        if (fixedP) s -= rAU(o) * dc(f) * pb(f - nIn);
         flux(f) = s;
+        if (coefficients)
+          cp(f) = f < nIn ? pressureFaceCoefficient(f, o, nei(f), w, rAU, dc) : (fixedP ? rAU(o) * dc(f) : 0.0);
       });
 }
 
-void FluidSolver::assemblePressureSource() {
+void FluidSolver::assemblePressure(bool matrix) {
   ScopedRegion region("mfsi::fluid::pressure::assemble");
   // Per-face fluxes, then the per-cell gather. (A per-cell pass computing each face's flux on both
-  // sides and summing it at once was measured 1.7x slower: the face data is read twice.)
+  // sides and summing it at once was measured 1.7x slower: the face data is read twice.) The
+  // matrix depends on rAU and the geometry only: the same for every pressure corrector of one
+  // outer iteration, so it is assembled once per outer iteration (`matrix`), the source every
+  // corrector. The fused matrix pass also forms the divergence.
+  const bool fusedMatrix = matrix && fusedCellPasses();
   if (fusedPressureSource())
-    pressureSourceFlux();
+    pressureSourceFlux(/*coefficients=*/fusedMatrix);
   else
     pressureSourceFluxFaces();
-  divergence<1>(exec_, mesh_, fluxP_, rhsP_, opt_.reduction, /*accumulate=*/false, /*sign=*/-1.0);
+  if (fusedMatrix) {
+    assemblePressureMatrixFused(/*stored=*/fusedPressureSource());
+  } else {
+    if (matrix) assemblePressureMatrixFaces();
+    divergence<1>(exec_, mesh_, fluxP_, rhsP_, opt_.reduction, /*accumulate=*/false, /*sign=*/-1.0);
+  }
+  if (matrix && pinsPressureLevel()) pinPressureLevel();
   finishPressureSource();
 }
 
@@ -989,10 +1099,10 @@ bool FluidSolver::pinsPressureLevel() const {
   return !bc_.fixesPressureLevel() && !compressible();
 }
 
-void FluidSolver::correctFluxAndVelocity() {
+void FluidSolver::correctFluxAndVelocity(bool flux) {
   ScopedRegion region("mfsi::fluid::correct");
   const lid_t nIn = nIn_;
-  {
+  if (flux) {
     ConstIndexView own = mesh_.faceOwner(), nei = mesh_.faceNeighbour();
     ConstIndexView kind = bc_.kind();
     ConstRealView w = fd_.weight, dc = fd_.deltaCoeff, rAU = rAU_, fl = fluxP_, p = p_;
@@ -1003,9 +1113,7 @@ void FluidSolver::correctFluxAndVelocity() {
         "mfsi::fluid::pressure::flux", RangePolicy(exec_, 0, nFaces_), KOKKOS_LAMBDA(lid_t f) {
           const lid_t o = own(f);
           if (f < nIn) {
-            const lid_t n = nei(f);
-            const real rAUf = w(f) * rAU(o) + (1.0 - w(f)) * rAU(n);
-            phi(f) = fl(f) - rAUf * dc(f) * (p(n) - p(o));
+            phi(f) = correctedFlux(f, o, nei(f), w, rAU, dc, fl, p);
           } else if (kind(f - nIn) == kFacePressure) {
             phi(f) = fl(f) + rAU(o) * dc(f) * p(o);
           }
@@ -1045,7 +1153,7 @@ void FluidSolver::storeDdtCorrection() {
   const lid_t nIn = nIn_;
   Kokkos::parallel_for(
       "mfsi::fluid::ddtCorr::store", RangePolicy(exec_, 0, nFaces_), KOKKOS_LAMBDA(lid_t f) {
-        d(f) = f < nIn ? ddtCorrectionFlux(f, own(f), nei(f), w, phi, U, sf) : 0.0;
+        d(f) = f < nIn ? ddtCorrectionFlux(f, own(f), nei(f), w, phi(f), U, sf) : 0.0;
       });
   dphiLatest_ = true;
 }
@@ -1067,11 +1175,38 @@ real FluidSolver::continuityMax(real& sum) {
   return mx;
 }
 
-real FluidSolver::finishStep(real& sum, bool& finite) {
+void FluidSolver::fluxAndDdtCorrection() {
+  // The final corrector's pressure::flux kernel, moved after the velocity correction (it reads
+  // neither U nor anything the correction writes; pressure relaxation, which would change p, is
+  // excluded by the caller) and joined by storeDdtCorrection, which reads the same face data: one
+  // face pass with the formulas of both kernels.
+  ConstIndexView own = mesh_.faceOwner(), nei = mesh_.faceNeighbour(), kind = bc_.kind();
+  ConstRealView w = fd_.weight, dc = fd_.deltaCoeff, rAU = rAU_, fl = fluxP_, p = p_;
+  ConstReal3View sf = geo_.faceArea, U = U_;
+  auto phi = phi_;
+  auto d = dphi_;
+  const lid_t nIn = nIn_;
+  Kokkos::parallel_for(
+      "mfsi::fluid::pressure::fluxDdt", RangePolicy(exec_, 0, nFaces_), KOKKOS_LAMBDA(lid_t f) {
+        const lid_t o = own(f);
+        if (f < nIn) {
+          const lid_t n = nei(f);
+          const real ph = correctedFlux(f, o, n, w, rAU, dc, fl, p);
+          phi(f) = ph;
+          d(f) = ddtCorrectionFlux(f, o, n, w, ph, U, sf);
+        } else {
+          if (kind(f - nIn) == kFacePressure) phi(f) = fl(f) + rAU(o) * dc(f) * p(o);
+          d(f) = 0.0;
+        }
+      });
+}
+
+real FluidSolver::finishStep(real& sum, bool& finite, bool ddtStored) {
   // storeDdtCorrection, continuityMax and fieldsFinite in one pass over the cells: each cell sums
   // its face fluxes and stores the correction flux of the faces it owns (every face has one
-  // owner, so each is written once, with the formula of storeDdtCorrection). The reductions get
-  // the same per-cell values over the same range as the separate kernels'.
+  // owner, so each is written once, with the formula of storeDdtCorrection; not if
+  // fluxAndDdtCorrection stored them). The reductions get the same per-cell values over the same
+  // range as the separate kernels'.
   ConstIndexView off = mesh_.cellFaceOffsets(), cf = mesh_.cellFaces(), own = mesh_.faceOwner(),
                  nei = mesh_.faceNeighbour();
   ConstRealView w = fd_.weight, phi = phi_, V = geo_.cellVolume, p = p_;
@@ -1088,7 +1223,7 @@ real FluidSolver::finishStep(real& sum, bool& finite) {
           const lid_t f = cf(e);
           const bool isOwner = own(f) == c;
           div += (isOwner ? 1.0 : -1.0) * phi(f);
-          if (isOwner) d(f) = f < nIn ? ddtCorrectionFlux(f, c, nei(f), w, phi, U, sf) : 0.0;
+          if (isOwner && !ddtStored) d(f) = f < nIn ? ddtCorrectionFlux(f, c, nei(f), w, phi(f), U, sf) : 0.0;
         }
         const real a = kmath::fabs(1.0 * div);
         const real r = a / V(c);
@@ -1160,6 +1295,7 @@ StepResult FluidSolver::solve() {
   StepResult res;
   const auto& pim = opt_.pimple;
   ConstRealView V = geo_.cellVolume;
+  bool ddtStored = false;  // fluxAndDdtCorrection formed the final fluxes and correction fluxes
   for (int outer = 0; outer < pim.nOuterCorrectors; ++outer) {
     updateBoundaryVelocity();
     // The velocity gradient feeds only the non-orthogonal diffusion correction and the limited
@@ -1205,8 +1341,7 @@ StepResult FluidSolver::solve() {
       if (pim.relaxPressure < 1.0) Kokkos::deep_copy(exec_, pPrev_, p_);  // read by the relaxation alone
       for (int no = 0; no <= pim.nNonOrthogonalCorrectors; ++no) {
         updatePressureGradient();
-        if (corr == 0 && no == 0) assemblePressureMatrix();
-        assemblePressureSource();
+        assemblePressure(/*matrix=*/corr == 0 && no == 0);
         ScopedRegion r3("mfsi::fluid::pressure::solve");
         // rAU, hence the matrix, is the same for every corrector of one outer iteration.
         const int refresh = opt_.pressurePreconditioner == PressurePreconditioner::Jacobi
@@ -1241,7 +1376,19 @@ StepResult FluidSolver::solve() {
         res.pressureIterations += st.iterations;
         if (st.breakdown) res.ok = false;
       }
-      correctFluxAndVelocity();
+      // The fluxes of a corrector are read only by the next outer iteration's momentum assembly,
+      // a resistance outlet's update and the end of the step: otherwise the next corrector
+      // rewrites them unread, and they are skipped. The final fluxes of the step are formed
+      // after the velocity correction, in one face pass with the end-of-step correction fluxes
+      // (not with pressure relaxation, which changes p after the fluxes are due).
+      const bool lastCorrector = corr == pim.nCorrectors - 1;
+      const bool atEnd =
+          fusedCellPasses() && lastCorrector && outer == pim.nOuterCorrectors - 1 && pim.relaxPressure >= 1.0;
+      correctFluxAndVelocity(/*flux=*/!atEnd && !(opt_.fusedMomentumAssembly && !lastCorrector && !hasResistance_));
+      if (atEnd) {
+        fluxAndDdtCorrection();
+        ddtStored = true;
+      }
     }
     res.outerIterations = outer + 1;
     if (outer == 0) {
@@ -1258,7 +1405,7 @@ StepResult FluidSolver::solve() {
   }
   if (fusedCellPasses()) {
     bool finite = true;
-    res.continuityMax = finishStep(res.continuitySum, finite);
+    res.continuityMax = finishStep(res.continuitySum, finite, ddtStored);
     if (!finite || !std::isfinite(res.continuityMax)) res.ok = false;
   } else {
     storeDdtCorrection();

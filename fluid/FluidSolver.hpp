@@ -129,6 +129,9 @@ class FluidSolver {
   void computeVelocityGradient() const;
   void pressureGradient(const ConstIndexView& cells);
   void updatePressureGradient();
+  /// updatePressureGradient's boundary pressures and gradient in one pass over the cells (fused
+  /// path, Gauss-linear stencil).
+  void pressureGradientFused();
   bool assembleMomentum(bool withB);
   void assembleMomentumFused(bool withB);
   void computeHbyA(bool withRAU);
@@ -143,22 +146,30 @@ class FluidSolver {
   void startFinalPressureSolve();
   void finishFinalPressureSolve();
   void computePhiHbyA();
-  void assemblePressureMatrix();
-  void assemblePressureMatrixFused();
+  /// Pressure equation: the source every corrector, with `matrix` also the matrix.
+  void assemblePressure(bool matrix);
+  /// The matrix and the source's divergence of fluxP_ in one pass over the cells; with `stored`
+  /// the face coefficients come from coefP_.
+  void assemblePressureMatrixFused(bool stored);
   void assemblePressureMatrixFaces();
-  void assemblePressureSource();
+  void pinPressureLevel();
   bool fusedPressureSource() const;
   /// The fused per-cell pressure-matrix and end-of-step passes apply (Gather reduction).
   bool fusedCellPasses() const;
-  void pressureSourceFlux();
+  void pressureSourceFlux(bool coefficients);
   void pressureSourceFluxFaces();
   void finishPressureSource();
   bool pinsPressureLevel() const;
-  void correctFluxAndVelocity();
+  /// Face fluxes from the solved pressure (unless `flux` is false: nothing reads them before the
+  /// next corrector rewrites them), relaxation, grad p and U.
+  void correctFluxAndVelocity(bool flux);
   bool compressible() const;
   void storeDdtCorrection();
   real continuityMax(real& sum);
-  real finishStep(real& sum, bool& finite);
+  /// The final corrector's face fluxes and the correction fluxes of the step in one face pass.
+  void fluxAndDdtCorrection();
+  /// The fused end-of-step pass (storeDdtCorrection unless `ddtStored`, continuity, finiteness).
+  real finishStep(real& sum, bool& finite, bool ddtStored);
   bool fieldsFinite();
 
   const HexMesh& mesh_;
@@ -178,12 +189,13 @@ class FluidSolver {
   Real3View U_, U0_, U00_;
   RealView p_, pPrev_, p0_, p00_;  ///< p0_, p00_: old time levels (artificial compressibility)
   RealView V0_, V00_;
-  Real3View HbyA_, gradP_, rhsU_, bodyU_;
+  Real3View HbyA_, gradP_, rhsU_;
   Tensor3View gradU_;
-  RealView rAU_, diagU_, cellDiag_, rhsP_, b_;
+  RealView rAU_, cellDiag_, rhsP_, b_;
   Real3View b3_;
   // Face fields.
   RealView phi_, meshPhi_, phiHbyA_, dphi_, dphi0_, dphi00_, sweptNew_, sweptOld_, fluxP_;
+  RealView coefP_;  ///< pressure-matrix face coefficients from pressureSourceFlux (fused path)
   Real3View fluxU_;  ///< like phiHbyA_, allocated by the face path that needs it
   // Boundary-face fields.
   Real3View Ub_, faceMeshVel_;
