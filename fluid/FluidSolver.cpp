@@ -30,15 +30,6 @@ KOKKOS_INLINE_FUNCTION real ddtCorrectionFlux(lid_t f, lid_t o, lid_t n, const C
   return phi - s;
 }
 
-/// Face flux of internal face f (owner o, neighbour n) from the solved pressure: the source flux
-/// `fl` minus the implicit part of the pressure-gradient flux. The pressure::flux kernel and the
-/// end-of-step flux pass share it.
-KOKKOS_INLINE_FUNCTION real correctedFlux(lid_t f, lid_t o, lid_t n, const ConstRealView& w, const ConstRealView& rAU,
-                                          const ConstRealView& dc, const ConstRealView& fl, const ConstRealView& p) {
-  const real rAUf = w(f) * rAU(o) + (1.0 - w(f)) * rAU(n);
-  return fl(f) - rAUf * dc(f) * (p(n) - p(o));
-}
-
 /// Pressure on boundary face b (face f, owner o with pressure po and gradient go): prescribed on
 /// fixed-pressure faces, the owner's value on empty faces (and everywhere without extrapolation),
 /// otherwise extrapolated from the owner with its gradient. updateBoundaryPressure and the fused
@@ -201,6 +192,35 @@ struct MomentumRowKernel {
 };
 
 }  // namespace
+
+/// Face fluxes from the solved pressure: the source flux `fl` minus the implicit part of the
+/// pressure-gradient flux, on internal and fixed-pressure faces (the other boundary faces keep the
+/// flux their condition sets). The pressure::flux kernel and the end-of-step flux pass share it.
+struct PressureFaceFlux {
+  lid_t nIn = 0;
+  ConstIndexView own, nei, kind;
+  ConstRealView w, dc, rAU, fl, p;
+  RealView phi;
+
+  /// The flux of internal face f (owner o, neighbour n).
+  KOKKOS_INLINE_FUNCTION real internal(lid_t f, lid_t o, lid_t n) const {
+    const real rAUf = w(f) * rAU(o) + (1.0 - w(f)) * rAU(n);
+    return fl(f) - rAUf * dc(f) * (p(n) - p(o));
+  }
+
+  /// The flux of boundary face f (owner o), stored on a fixed-pressure face.
+  KOKKOS_INLINE_FUNCTION void boundary(lid_t f, lid_t o) const {
+    if (kind(f - nIn) == kFacePressure) phi(f) = fl(f) + rAU(o) * dc(f) * p(o);
+  }
+
+  KOKKOS_INLINE_FUNCTION void operator()(lid_t f) const {
+    const lid_t o = own(f);
+    if (f < nIn)
+      phi(f) = internal(f, o, nei(f));
+    else
+      boundary(f, o);
+  }
+};
 
 FluidSolver::FluidSolver(const HexMesh& mesh, const FluidOptions& options)
     : mesh_(mesh),
@@ -1101,24 +1121,9 @@ bool FluidSolver::pinsPressureLevel() const {
 
 void FluidSolver::correctFluxAndVelocity(bool flux) {
   ScopedRegion region("mfsi::fluid::correct");
-  const lid_t nIn = nIn_;
-  if (flux) {
-    ConstIndexView own = mesh_.faceOwner(), nei = mesh_.faceNeighbour();
-    ConstIndexView kind = bc_.kind();
-    ConstRealView w = fd_.weight, dc = fd_.deltaCoeff, rAU = rAU_, fl = fluxP_, p = p_;
-    auto phi = phi_;
-    // Face fluxes from the pressure just solved (before any relaxation), with the same
-    // non-orthogonal correction that was in the matrix source: sum_f phi_f = 0 to solver tolerance.
-    Kokkos::parallel_for(
-        "mfsi::fluid::pressure::flux", RangePolicy(exec_, 0, nFaces_), KOKKOS_LAMBDA(lid_t f) {
-          const lid_t o = own(f);
-          if (f < nIn) {
-            phi(f) = correctedFlux(f, o, nei(f), w, rAU, dc, fl, p);
-          } else if (kind(f - nIn) == kFacePressure) {
-            phi(f) = fl(f) + rAU(o) * dc(f) * p(o);
-          }
-        });
-  }
+  // Face fluxes from the pressure just solved (before any relaxation), with the same
+  // non-orthogonal correction that was in the matrix source: sum_f phi_f = 0 to solver tolerance.
+  if (flux) Kokkos::parallel_for("mfsi::fluid::pressure::flux", RangePolicy(exec_, 0, nFaces_), pressureFaceFlux());
   gradPValid_ = false;  // p is the one just solved for
   const real ap = opt_.pimple.relaxPressure;
   if (ap < 1.0) {
@@ -1147,8 +1152,9 @@ bool FluidSolver::compressible() const {
 
 void FluidSolver::storeDdtCorrection() {
   ConstIndexView own = mesh_.faceOwner(), nei = mesh_.faceNeighbour();
-  ConstRealView w = fd_.weight, phi = phi_;
+  ConstRealView w = fd_.weight;
   ConstReal3View sf = geo_.faceArea, U = U_;
+  auto phi = phi_;  // read where `flux` has just written it: not through a read-only (RandomRead) view
   auto d = dphi_;
   const lid_t nIn = nIn_;
   Kokkos::parallel_for(
@@ -1180,8 +1186,9 @@ void FluidSolver::fluxAndDdtCorrection() {
   // neither U nor anything the correction writes; pressure relaxation, which would change p, is
   // excluded by the caller) and joined by storeDdtCorrection, which reads the same face data: one
   // face pass with the formulas of both kernels.
-  ConstIndexView own = mesh_.faceOwner(), nei = mesh_.faceNeighbour(), kind = bc_.kind();
-  ConstRealView w = fd_.weight, dc = fd_.deltaCoeff, rAU = rAU_, fl = fluxP_, p = p_;
+  const PressureFaceFlux flux = pressureFaceFlux();
+  ConstIndexView own = mesh_.faceOwner(), nei = mesh_.faceNeighbour();
+  ConstRealView w = fd_.weight;
   ConstReal3View sf = geo_.faceArea, U = U_;
   auto phi = phi_;
   auto d = dphi_;
@@ -1191,14 +1198,29 @@ void FluidSolver::fluxAndDdtCorrection() {
         const lid_t o = own(f);
         if (f < nIn) {
           const lid_t n = nei(f);
-          const real ph = correctedFlux(f, o, n, w, rAU, dc, fl, p);
+          const real ph = flux.internal(f, o, n);
           phi(f) = ph;
           d(f) = ddtCorrectionFlux(f, o, n, w, ph, U, sf);
         } else {
-          if (kind(f - nIn) == kFacePressure) phi(f) = fl(f) + rAU(o) * dc(f) * p(o);
+          flux.boundary(f, o);
           d(f) = 0.0;
         }
       });
+}
+
+PressureFaceFlux FluidSolver::pressureFaceFlux() const {
+  PressureFaceFlux F;
+  F.nIn = nIn_;
+  F.own = mesh_.faceOwner();
+  F.nei = mesh_.faceNeighbour();
+  F.kind = bc_.kind();
+  F.w = fd_.weight;
+  F.dc = fd_.deltaCoeff;
+  F.rAU = rAU_;
+  F.fl = fluxP_;
+  F.p = p_;
+  F.phi = phi_;
+  return F;
 }
 
 real FluidSolver::finishStep(real& sum, bool& finite, bool ddtStored) {
@@ -1384,7 +1406,8 @@ StepResult FluidSolver::solve() {
       const bool lastCorrector = corr == pim.nCorrectors - 1;
       const bool atEnd =
           fusedCellPasses() && lastCorrector && outer == pim.nOuterCorrectors - 1 && pim.relaxPressure >= 1.0;
-      correctFluxAndVelocity(/*flux=*/!atEnd && !(opt_.fusedMomentumAssembly && !lastCorrector && !hasResistance_));
+      const bool fluxesUnread = opt_.fusedMomentumAssembly && !lastCorrector && !hasResistance_;
+      correctFluxAndVelocity(/*flux=*/!atEnd && !fluxesUnread);
       if (atEnd) {
         fluxAndDdtCorrection();
         ddtStored = true;

@@ -39,6 +39,8 @@ namespace mfsi::fluid {
 
 /// Device functor of the phiHbyA face formula (FluidSolver.cpp).
 struct PhiHbyAFace;
+/// Device functor writing the face fluxes from the solved pressure (FluidSolver.cpp).
+struct PressureFaceFlux;
 
 /// \brief What one call of `solve()` did.
 struct StepResult {
@@ -137,6 +139,8 @@ class FluidSolver {
   void computeHbyA(bool withRAU);
   /// The phiHbyA face formula with this step's fields and coefficients (device functor).
   PhiHbyAFace phiHbyAFace() const;
+  /// The pressure-flux face formula with this step's fields (device functor).
+  PressureFaceFlux pressureFaceFlux() const;
   /// U = U0 + (dt / dt0) (U0 - U00): the first momentum solve's initial guess (extrapolateGuess).
   void extrapolateVelocity();
   /// Whether U00_ is kept for the extrapolated initial guess of the momentum solve.

@@ -431,8 +431,8 @@ double estimateLambdaMax(const ExecSpace& exec, const CsrMatrix& A, const ConstR
 /// (x 3) neighbouring aggregates and two more along each axis, minus the diagonal), and their
 /// restriction rows (an aggregate and the face layer around it: 4 + 8 / 8 + 24).
 constexpr int kEllWidths[] = {4, 6, 8, 12, 32};
-/// Largest mean padding per row of an ELL layout of width w: 3 entries, or w / 4 for the wide
-/// lattice-level widths (boundary rows of a small coarse lattice are up to ~30 % shorter: 8^3;
+/// Largest mean padding per row of an ELL layout of width w: 3 entries, or w / 3 (rounded down)
+/// for the wide lattice-level widths (boundary rows of a small coarse lattice are up to ~30 % shorter: 8^3;
 /// padding costs zeros read in a vectorised sweep, CSR a branch and a column index per entry).
 constexpr double ellMaxPadding(int w) { return w / 3 > 3 ? w / 3 : 3.0; }
 /// Most distinct column patterns of a pattern-compressed ELL operator (one-byte ids).

@@ -98,6 +98,24 @@ MeshMotion wobble(const HexMesh& mesh) {
   };
 }
 
+/// `steps` steps of dt of the solvers a and b, each on its own copy of `mesh`, both meshes moved by
+/// `motion` in the steps s where moves(s).
+template <class Moves>
+void stepWithMotion(FluidSolver& a, FluidSolver& b, const HexMesh& mesh, const MeshMotion& motion, int steps, double dt,
+                    const Moves& moves) {
+  for (int s = 0; s < steps; ++s) {
+    for (FluidSolver* f : {&a, &b}) {
+      f->beginStep(s * dt, dt);
+      if (moves(s)) {
+        Real3View pts("test::points", mesh.nNodes());
+        motion((s + 1) * dt, pts);
+        f->moveMesh(pts);
+      }
+      ASSERT_TRUE(f->solve().ok) << "step " << s;
+    }
+  }
+}
+
 std::set<std::string>& allocations() {
   static std::set<std::string> labels;
   return labels;
@@ -222,19 +240,7 @@ TEST(FusedKernels, PressureGradientPassOnAMovingMesh) {
   FluidOptions unfused = o;
   unfused.fusedMomentumAssembly = false;
   FluidSolver a(meshA, o), b(meshB, unfused);
-  const auto motion = wobble(meshA);
-  const double dt = 0.05;
-  for (int s = 0; s < 5; ++s) {
-    for (FluidSolver* f : {&a, &b}) {
-      f->beginStep(s * dt, dt);
-      if (s != 2) {
-        Real3View pts("test::points", meshA.nNodes());
-        motion((s + 1) * dt, pts);
-        f->moveMesh(pts);
-      }
-      ASSERT_TRUE(f->solve().ok);
-    }
-  }
+  ASSERT_NO_FATAL_FAILURE(stepWithMotion(a, b, meshA, wobble(meshA), 5, 0.05, [](int s) { return s != 2; }));
   expectSame(fields(a), fields(b), "moving channel");
   EXPECT_LE(boundaryPressureDifference(a, b), 1e-12);
 }
@@ -250,19 +256,8 @@ TEST(FusedKernels, MovingMeshPathsEqualTheFacePaths) {
     FluidOptions unfused = o;
     unfused.fusedMomentumAssembly = false;
     FluidSolver a(meshA, o), b(meshB, unfused);
-    const auto motion = wobble(meshA);
-    const double dt = 0.05;
-    for (int s = 0; s < 7; ++s) {
-      for (FluidSolver* f : {&a, &b}) {
-        f->beginStep(s * dt, dt);
-        if (s == 1 || s == 2 || s == 5) {
-          Real3View pts("test::points", meshA.nNodes());
-          motion((s + 1) * dt, pts);
-          f->moveMesh(pts);
-        }
-        ASSERT_TRUE(f->solve().ok);
-      }
-    }
+    ASSERT_NO_FATAL_FAILURE(
+        stepWithMotion(a, b, meshA, wobble(meshA), 7, 0.05, [](int s) { return s == 1 || s == 2 || s == 5; }));
     expectSame(fields(a), fields(b), time == TimeScheme::Euler ? "moving Euler" : "moving BDF2");
   }
 }
