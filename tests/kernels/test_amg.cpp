@@ -522,13 +522,7 @@ std::vector<double> referenceCycle(const mfsi::AmgPreconditioner& amg, std::size
 mfsi::CsrMatrix shuffled(const mfsi::CsrMatrix& M) {
   const HostMatrix h = hostMatrix(M);
   const lid_t n = h.nRows;
-  std::vector<lid_t> perm(n);
-  for (lid_t i = 0; i < n; ++i) perm[i] = i;
-  std::uint32_t state = 12345u;
-  for (lid_t i = n - 1; i > 0; --i) {
-    state = state * 1664525u + 1013904223u;
-    std::swap(perm[i], perm[static_cast<lid_t>(state % static_cast<std::uint32_t>(i + 1))]);
-  }
+  const std::vector<lid_t> perm = mfsi::test::randomPermutation(n, 12345u);
   std::vector<lid_t> inv(n);
   for (lid_t i = 0; i < n; ++i) inv[perm[i]] = i;
   // New row perm[i] = old row i, columns mapped and sorted.

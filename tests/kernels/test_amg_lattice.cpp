@@ -127,14 +127,7 @@ TEST(AmgLattice, DetectorRejectsEverythingElse) {
   // y fastest numbering of a cube with a different x and y extent would be another lattice; a
   // pseudo-random numbering is none.
   {
-    std::vector<lid_t> perm(n);
-    for (lid_t i = 0; i < n; ++i) perm[i] = i;
-    std::uint32_t state = 4321u;
-    for (lid_t i = n - 1; i > 0; --i) {
-      state = state * 1664525u + 1013904223u;
-      std::swap(perm[i], perm[static_cast<lid_t>(state % static_cast<std::uint32_t>(i + 1))]);
-    }
-    rejects(renumbered(latticeAdjacency(nx, ny, nz), perm), "random numbering");
+    rejects(renumbered(latticeAdjacency(nx, ny, nz), mfsi::test::randomPermutation(n, 4321u)), "random numbering");
   }
   // Periodic in x: the first and last cell of every x line coupled.
   {

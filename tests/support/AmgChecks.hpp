@@ -8,7 +8,10 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstdint>
 #include <string>
+#include <utility>
+#include <vector>
 
 namespace mfsi::test {
 
@@ -25,6 +28,19 @@ inline RealView roughVector(lid_t n, bool zeroMean, int kind = 0) {
     for (lid_t i = 0; i < n; ++i) h(i) -= s / n;
   Kokkos::deep_copy(b, h);
   return b;
+}
+
+/// A fixed pseudo-random permutation of 0..n-1 (Fisher-Yates on a linear congruential sequence
+/// started at `seed`): renumbers model matrices so that rows share no column pattern.
+inline std::vector<lid_t> randomPermutation(lid_t n, std::uint32_t seed) {
+  std::vector<lid_t> perm(n);
+  for (lid_t i = 0; i < n; ++i) perm[i] = i;
+  std::uint32_t state = seed;
+  for (lid_t i = n - 1; i > 0; --i) {
+    state = state * 1664525u + 1013904223u;
+    std::swap(perm[i], perm[static_cast<lid_t>(state % static_cast<std::uint32_t>(i + 1))]);
+  }
+  return perm;
 }
 
 /// <M u, v> = <u, M v> to `rel` (relative to sqrt(<Mu,u><Mv,v>)) and <M u, u>, <M v, v> > 0 for
