@@ -977,25 +977,41 @@ namespace {
 using Level = detail::AmgHierarchy::Level;
 using Step = detail::AmgHierarchy::Step;
 
-/// Step coefficients of `sweeps` smoother applications. Chebyshev: the polynomial of Adams et al.
-/// (2003) in D^{-1}A on [lambda_max / ratio, lambda_max]; the same polynomial before and after
-/// the coarse correction keeps the V-cycle symmetric, so plain CG can use it.
+/// Step coefficients of `sweeps` smoother applications, each a polynomial in D^{-1}A (so the
+/// same polynomial before and after the coarse correction keeps the V-cycle symmetric and plain
+/// CG can use it). Every step is d = c1 d + c2 D^{-1} (b - A x), x += d.
+///  - ChebyshevFourthKind (Lottes 2023, "Optimal polynomial smoothers for multigrid V-cycles",
+///    the 4th-kind recurrence): on [0, rho] with rho = the boosted lambda_max,
+///    d_0 = 4 / (3 rho) D^{-1} r_0, d_k = (2k - 1) / (2k + 3) d_{k-1} + (8k + 4) / ((2k + 3) rho)
+///    D^{-1} r_k. It minimises the V-cycle's error bound over the whole of [0, rho] instead of
+///    damping [rho / ratio, rho] only, and needs no lower bound.
+///  - Chebyshev: the first-kind polynomial of Adams et al. (2003) on [rho / ratio, rho].
 std::vector<Step> smootherSteps(double lambdaMax, const AmgOptions& opt, int sweeps) {
   std::vector<Step> steps;
+  const double rho = kChebyshevBoost * lambdaMax;
   for (int s = 0; s < sweeps; ++s) {
-    if (opt.smoother == AmgSmoother::Jacobi) {
-      steps.push_back({0.0, opt.jacobiWeight > 0.0 ? opt.jacobiWeight : 4.0 / (3.0 * lambdaMax)});
-      continue;
-    }
-    const double lmax = kChebyshevBoost * lambdaMax, lmin = lmax / opt.chebyshevRatio;
-    const double theta = 0.5 * (lmax + lmin), delta = 0.5 * (lmax - lmin);
-    const double sigma = theta / delta;
-    double rho = 1.0 / sigma;
-    steps.push_back({0.0, 1.0 / theta});
-    for (int k = 1; k < opt.chebyshevDegree; ++k) {
-      const double rhoNew = 1.0 / (2.0 * sigma - rho);
-      steps.push_back({rhoNew * rho, 2.0 * rhoNew / delta});
-      rho = rhoNew;
+    switch (opt.smoother) {
+      case AmgSmoother::Jacobi:
+        steps.push_back({0.0, opt.jacobiWeight > 0.0 ? opt.jacobiWeight : 4.0 / (3.0 * lambdaMax)});
+        break;
+      case AmgSmoother::ChebyshevFourthKind:
+        steps.push_back({0.0, 4.0 / (3.0 * rho)});
+        for (int k = 1; k < opt.chebyshevDegree; ++k)
+          steps.push_back({(2.0 * k - 1.0) / (2.0 * k + 3.0), (8.0 * k + 4.0) / ((2.0 * k + 3.0) * rho)});
+        break;
+      case AmgSmoother::Chebyshev: {
+        const double lmin = rho / opt.chebyshevRatio;
+        const double theta = 0.5 * (rho + lmin), delta = 0.5 * (rho - lmin);
+        const double sigma = theta / delta;
+        double r = 1.0 / sigma;
+        steps.push_back({0.0, 1.0 / theta});
+        for (int k = 1; k < opt.chebyshevDegree; ++k) {
+          const double rNew = 1.0 / (2.0 * sigma - r);
+          steps.push_back({rNew * r, 2.0 * rNew / delta});
+          r = rNew;
+        }
+        break;
+      }
     }
   }
   return steps;

@@ -18,9 +18,10 @@
 ///    (`AmgProlongation::Unsmoothed` keeps P_tent; it converges poorly and is there for comparison).
 ///  - Galerkin coarse operator A_c = R (A P), R = P^T, by two row-parallel sparse-product kernels
 ///    into sparsities computed once on the host (A P is kept: ~1.5x the memory of A per level).
-///  - symmetric V-cycle with Chebyshev (default) or damped-Jacobi smoothing on every level, both
-///    in D^{-1}A with lambda_max from a few Lanczos steps; dense pseudo-inverse on the coarsest
-///    level (<= coarseSize rows; Eigen on the host at set-up, applied on the device).
+///  - symmetric V-cycle with 4th-kind Chebyshev (default, Lottes 2023), first-kind Chebyshev or
+///    damped-Jacobi smoothing on every level, all in D^{-1}A with lambda_max from a few Lanczos
+///    steps; dense pseudo-inverse on the coarsest level (<= coarseSize rows; Eigen on the host at
+///    set-up, applied on the device).
 ///  - every kernel writes its own rows only (no atomics): the preconditioner is deterministic.
 ///
 /// Cycle (Amg.cpp): the V-cycle runs on its own copies of every level's operator, P and R,
@@ -81,7 +82,11 @@ enum class AmgProlongation { Smoothed, Unsmoothed };
 /// swept vectorised on host backends); other levels, and every other matrix (unstructured,
 /// multi-block, anisotropic), are aggregated greedily. Greedy: greedy everywhere.
 enum class AmgAggregation { Auto, Greedy };
-enum class AmgSmoother { Chebyshev, Jacobi };
+/// \brief Smoother of every level, a polynomial in D^{-1}A. ChebyshevFourthKind (the default):
+/// Lottes' 4th-kind Chebyshev polynomial on [0, lambda_max] (no lower bound to choose).
+/// Chebyshev: the first-kind polynomial on [lambda_max / chebyshevRatio, lambda_max]. Jacobi:
+/// damped Jacobi.
+enum class AmgSmoother { ChebyshevFourthKind, Chebyshev, Jacobi };
 /// \brief Arithmetic of the V-cycle. Mixed: every level's operator, P, R and diagonal are float
 /// copies and the cycle runs in float (apply()'s r and z stay double; the coarsest dense solve
 /// stays double); set-up and value updates compute in double either way. Mixed moves ~40 % fewer
@@ -91,16 +96,18 @@ enum class AmgPrecision { Double, Mixed };
 /// \brief Options of the AMG preconditioner. Defaults suit the 3D pressure Poisson equation.
 struct AmgOptions {
   AmgProlongation prolongation = AmgProlongation::Smoothed;
-  AmgSmoother smoother = AmgSmoother::Chebyshev;
+  AmgSmoother smoother = AmgSmoother::ChebyshevFourthKind;
   int sweeps = 1;           ///< smoother applications before and after the coarse correction
-  /// Polynomial degree (SpMVs per Chebyshev application). 3 measured best on the 3D cavity at
-  /// 64^3 (perf/bench_cavity3d): AMG-CG iterations per step 11.5 / 9.4 / 8.6 / 8.2 for degree
-  /// 2 / 3 / 4 / 5, and the least time per step at 3 (~7 % less than 2; 4 and 5 cost more per
-  /// iteration than they save).
-  int chebyshevDegree = 3;
-  /// Chebyshev damps the spectrum of D^{-1}A in [lambda_max / ratio, lambda_max]. The coarse
-  /// level handles the rest; ~ the coarsening ratio (8-30 here) is the usual choice, 10 measured
-  /// best on the 3D Poisson equation (11 vs 16 CG iterations with 30 at 64^3).
+  /// Polynomial degree (SpMVs per smoother application). 4th kind, measured on the 3D cavity at
+  /// 64^3 (perf/bench_cavity3d, AMG-CG iterations per step): degree 1 / 2 / 3 / 4: 11.7 / 7.40 /
+  /// 7.40 / 7.33; degree 2 needs the fewest sweeps per step. First kind (ratio 10, the default
+  /// before): degree 3 7.53, degree 2 7.53 with ratio 6. 4th kind degree 2 on the finest level
+  /// and 3 below: 7.13, not worth the two extra level-1 sweeps per cycle.
+  int chebyshevDegree = 2;
+  /// First-kind Chebyshev damps the spectrum of D^{-1}A in [lambda_max / ratio, lambda_max]. The
+  /// coarse level handles the rest; ~ the coarsening ratio (8-30 here) is the usual choice, 10
+  /// measured best with degree 3 (11 vs 16 CG iterations with 30 at 64^3). Not used by the
+  /// 4th kind.
   real chebyshevRatio = 10.0;
   real jacobiWeight = 0.0;  ///< damped-Jacobi omega; 0 = 4 / (3 lambda_max(D^{-1}A))
   /// theta of the strength of connection (0: every coupling is strong). Smoothed-aggregation
