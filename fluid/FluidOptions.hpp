@@ -147,6 +147,11 @@ struct PimpleOptions {
   /// Both start closer to the answer, so the solves need fewer iterations (3D cavity, 64^3:
   /// momentum 8.5 -> 6.5, pressure 9.4 -> 8.5 iterations per step).
   bool extrapolateGuess = true;
+  /// With extrapolateGuess: the final pressure corrector adds the best multiple s of the last
+  /// final change instead of all of it (s minimising the energy norm of the guess's error on this
+  /// step's matrix and source; one extra pass over the matrix). 3D cavity 64^3: 6.53 instead of
+  /// 7.27 pressure iterations per step. Off: s = 1 (for comparison; not a scene key).
+  bool projectFinalGuess = true;
 };
 
 /// \brief Artificial (weak) compressibility of the continuity equation: (1 / (rho c^2)) dp/dt +
