@@ -1385,6 +1385,7 @@ StepResult FluidSolver::solve() {
       for (int no = 0; no <= pim.nNonOrthogonalCorrectors; ++no) {
         updatePressureGradient();
         assemblePressure(/*matrix=*/corr == 0 && no == 0);
+        if (corr == 0 && no == 0) linear_.pressureValuesChanged(exec_, Ap_);
         ScopedRegion r3("mfsi::fluid::pressure::solve");
         // rAU, hence the matrix, is the same for every corrector of one outer iteration.
         const int refresh = opt_.pressurePreconditioner == PressurePreconditioner::Jacobi

@@ -75,6 +75,10 @@ void LinearSolver::pressureMatrixChanged(const ExecSpace& exec, const CsrMatrix&
   pReady_ = true;
 }
 
+void LinearSolver::pressureValuesChanged(const ExecSpace& exec, const CsrMatrix& A) {
+  pSolver_->matrixChanged(exec, A);
+}
+
 LinearSolveStats LinearSolver::solveMomentum(const ExecSpace& exec, const CsrMatrix& A, const ConstRealView& b,
                                              const RealView& x, const LinearSolverOptions& o) {
   MFSI_CHECK(uReady_, "LinearSolver::solveMomentum: momentumMatrixChanged was not called");

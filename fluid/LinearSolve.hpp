@@ -46,6 +46,10 @@ class LinearSolver {
   void momentumMatrixChanged(const ExecSpace& exec, const CsrMatrix& A);
   /// \brief The pressure matrix got new values (same sparsity): refresh its preconditioner.
   void pressureMatrixChanged(const ExecSpace& exec, const CsrMatrix& A);
+  /// \brief The pressure matrix values were (re)assembled: refresh the Krylov solver's own copy
+  /// (CG's symmetric lattice copy). Call after every assembly of the values, also between
+  /// preconditioner refreshes.
+  void pressureValuesChanged(const ExecSpace& exec, const CsrMatrix& A);
   /// \brief Solve the momentum system A x = b (x holds the initial guess).
   LinearSolveStats solveMomentum(const ExecSpace& exec, const CsrMatrix& A, const ConstRealView& b, const RealView& x,
                                  const LinearSolverOptions& o);

@@ -178,6 +178,8 @@ KrylovResult ConjugateGradient::solve(const ExecSpace& exec, const CsrMatrix& A,
   return run(exec, A, b, x, M, &r0);
 }
 
+void ConjugateGradient::matrixChanged(const ExecSpace& exec, const CsrMatrix& A) { lattice_.update(exec, A); }
+
 KrylovResult ConjugateGradient::run(const ExecSpace& exec, const CsrMatrix& A, const ConstRealView& b,
                                     const RealView& x, Preconditioner& M, const InitialResidual* r0) {
   ScopedRegion region("mfsi::kernels::krylov::cg");
@@ -190,6 +192,7 @@ KrylovResult ConjugateGradient::run(const ExecSpace& exec, const CsrMatrix& A, c
   const RealView z = z_, p = p_, q = q_;
   const bool project = options_.nullSpace == NullSpace::Constant;
   const double nGlobal = comm_.globalSum(static_cast<double>(n));
+  const bool lattice = lattice_.matches(A);
 
   KrylovResult res;
   const Start s0 = start(exec, comm_, options_, A, b, x, r, r0, nGlobal, res);
@@ -231,7 +234,7 @@ KrylovResult ConjugateGradient::run(const ExecSpace& exec, const CsrMatrix& A, c
 
   for (int it = 1; it <= options_.maxIterations; ++it) {
     comm_.updateGhosts(exec, p);
-    const double pq = blas::spmvDot(exec, comm_, A, p, q, p);
+    const double pq = lattice ? lattice_.spmvDot(exec, comm_, p, q, p) : blas::spmvDot(exec, comm_, A, p, q, p);
     if (!finite(pq)) return finish(KrylovStatus::NotFinite);
     if (pq == 0.0 || rz == 0.0) return finish(KrylovStatus::Breakdown);
     const double alpha = rz / pq;

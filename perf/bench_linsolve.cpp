@@ -10,6 +10,12 @@
 // backends and reads no column index: 8 B per entry), x read once, y written once (no
 // write-allocate, as STREAM counts it) - i.e. what a perfectly cached kernel needs.
 //
+// SpmvDot/N/lattice: CG's fused q = A p with p.q on the N^3 Dirichlet Poisson matrix, CSR
+// (blas::spmvDot) vs the symmetric lattice copy (SymmetricLatticeMatrix); counter update_s: one
+// refresh of the copy (ConjugateGradient::matrixChanged). Compare in one run:
+//   OMP_PROC_BIND=spread OMP_PLACES=cores OMP_NUM_THREADS=1 build/perf/bench_linsolve
+//     --benchmark_filter='SpmvDot' --benchmark_repetitions=5
+//
 // PressureSolve/N/P/M: CG to 1e-8 relative on the Dirichlet Poisson matrix of N^3 cells with a rough
 // right-hand side; P = 0 Jacobi, 1 smoothed-aggregation AMG; M = 0 AMG V-cycle in double, 1 in mixed
 // precision (float cycle, AmgPrecision::Mixed). Compare the two AMG variants in one run:
@@ -24,6 +30,7 @@
 #include "kernels/Amg.hpp"
 #include "kernels/CsrBuild.hpp"
 #include "kernels/Krylov.hpp"
+#include "kernels/LatticeMatrix.hpp"
 
 #include <algorithm>
 #include <chrono>
@@ -82,6 +89,46 @@ void BM_ResidualDot(benchmark::State& state) {
   }
   benchmark::DoNotOptimize(rr);
   mfsi::bench::setRates(state, matrixBytes(A) + 24.0 * A.nRows, A.nRows, "rows/s");
+}
+
+/// CG's fused q = A p with p.q: the CSR kernel (blas::spmvDot, row runs on host backends) vs the
+/// symmetric lattice copy ConjugateGradient takes after matrixChanged (SymmetricLatticeMatrix).
+/// GB/s: matrix (CSR row runs: 8 B per entry; lattice: 32 B per row) + p read + q written.
+void BM_SpmvDot(benchmark::State& state) {
+  const mfsi::lid_t n = static_cast<mfsi::lid_t>(state.range(0));
+  const bool lattice = state.range(1) == 1;
+  const auto A = mfsi::buildPoisson7({n, n, n}, mfsi::ModelBoundary::Dirichlet);
+  mfsi::RealView p("mfsi::perf::linsolve::p", A.nRows), q("mfsi::perf::linsolve::q", A.nRows);
+  {
+    auto h = Kokkos::create_mirror_view(p);
+    for (mfsi::lid_t i = 0; i < A.nRows; ++i) h(i) = std::sin(0.7 * i) + 0.3;
+    Kokkos::deep_copy(p, h);
+  }
+  mfsi::ExecSpace exec;
+  const mfsi::SolverComm comm;
+  mfsi::SymmetricLatticeMatrix L;
+  if (lattice && !L.update(exec, A)) {
+    state.SkipWithError("not a symmetric lattice matrix");
+    return;
+  }
+  double pq = 0;
+  for (auto _ : state) {
+    exec.fence();
+    const auto t0 = Clock::now();
+    pq = lattice ? L.spmvDot(exec, comm, p, q, p) : mfsi::blas::spmvDot(exec, comm, A, p, q, p);
+    state.SetIterationTime(seconds(t0, Clock::now()));
+  }
+  benchmark::DoNotOptimize(pq);
+  const double bytes = (lattice ? 32.0 * A.nRows : matrixBytes(A, /*runs=*/true)) + 16.0 * A.nRows;
+  mfsi::bench::setRates(state, bytes, A.nRows, "rows/s");
+  // One refresh of the copy (what matrixChanged costs per new set of values).
+  if (lattice) {
+    exec.fence();
+    const auto t0 = Clock::now();
+    L.update(exec, A);
+    exec.fence();
+    state.counters["update_s"] = seconds(t0, Clock::now());
+  }
 }
 
 void BM_Dot(benchmark::State& state) {
@@ -206,6 +253,13 @@ BENCHMARK(BM_Spmv)
 BENCHMARK(BM_ResidualDot)
     ->Arg(kSmall)
     ->Arg(kLarge)
+    ->Unit(benchmark::kMillisecond)
+    ->UseManualTime()
+    ->ComputeStatistics("min", minOf)
+    ->ComputeStatistics("max", maxOf);
+BENCHMARK(BM_SpmvDot)
+    ->ArgsProduct({{kSmall, kLarge}, {0, 1}})
+    ->ArgNames({"N", "lattice"})
     ->Unit(benchmark::kMillisecond)
     ->UseManualTime()
     ->ComputeStatistics("min", minOf)
