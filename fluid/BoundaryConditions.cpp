@@ -9,11 +9,16 @@ namespace mfsi::fluid {
 
 const char* toString(FaceKind k) {
   switch (k) {
-    case kFaceVelocity: return "velocity";
-    case kFaceWall: return "wall";
-    case kFaceSlip: return "slip";
-    case kFaceEmpty: return "empty";
-    case kFacePressure: return "pressure";
+    case kFaceVelocity:
+      return "velocity";
+    case kFaceWall:
+      return "wall";
+    case kFaceSlip:
+      return "slip";
+    case kFaceEmpty:
+      return "empty";
+    case kFacePressure:
+      return "pressure";
   }
   return "?";
 }
@@ -23,13 +28,19 @@ namespace {
 FaceKind faceKindOf(BoundaryType t) {
   switch (t) {
     case BoundaryType::FixedVelocity:
-    case BoundaryType::FlowRate: return kFaceVelocity;
-    case BoundaryType::Wall: return kFaceWall;
-    case BoundaryType::Slip: return kFaceSlip;
-    case BoundaryType::Empty: return kFaceEmpty;
+    case BoundaryType::FlowRate:
+      return kFaceVelocity;
+    case BoundaryType::Wall:
+      return kFaceWall;
+    case BoundaryType::Slip:
+      return kFaceSlip;
+    case BoundaryType::Empty:
+      return kFaceEmpty;
     case BoundaryType::FixedPressure:
-    case BoundaryType::Resistance: return kFacePressure;
-    case BoundaryType::Auto: break;
+    case BoundaryType::Resistance:
+      return kFacePressure;
+    case BoundaryType::Auto:
+      break;
   }
   return kFaceWall;
 }
@@ -82,9 +93,15 @@ BoundaryConditions::BoundaryConditions(const HexMesh& mesh, const FluidOptions& 
     if (given[i]) rp.bc = *given[i];
     if (rp.bc.type == BoundaryType::Auto) {
       switch (mp[i].kind) {
-        case PatchKind::Wall: rp.bc.type = BoundaryType::Wall; break;
-        case PatchKind::Symmetry: rp.bc.type = BoundaryType::Slip; break;
-        case PatchKind::Empty: rp.bc.type = BoundaryType::Empty; break;
+        case PatchKind::Wall:
+          rp.bc.type = BoundaryType::Wall;
+          break;
+        case PatchKind::Symmetry:
+          rp.bc.type = BoundaryType::Slip;
+          break;
+        case PatchKind::Empty:
+          rp.bc.type = BoundaryType::Empty;
+          break;
         case PatchKind::BaffleMaster:
         case PatchKind::BaffleSlave:
           rp.bc.type = BoundaryType::Wall;
@@ -92,16 +109,15 @@ BoundaryConditions::BoundaryConditions(const HexMesh& mesh, const FluidOptions& 
           break;
         case PatchKind::Patch:
           MFSI_CHECK(false, "fluid: patch '" << rp.name << "' of mesh '" << mesh.source()
-                                             << "' has no boundary condition (key fluid.boundaries." << rp.name
-                                             << ")");
+                                             << "' has no boundary condition (key fluid.boundaries." << rp.name << ")");
       }
     }
     rp.type = rp.bc.type;
     MFSI_CHECK(!(rp.type == BoundaryType::FlowRate && rp.bc.profile == Profile::Function),
                "fluid: patch '" << rp.name << "': a flow-rate inlet takes a uniform or parabolic profile");
-    MFSI_CHECK(!(rp.type == BoundaryType::FixedVelocity && rp.bc.profile == Profile::Function &&
-                 !rp.bc.velocityFunction),
-               "fluid: patch '" << rp.name << "': profile 'function' needs a velocity function");
+    MFSI_CHECK(
+        !(rp.type == BoundaryType::FixedVelocity && rp.bc.profile == Profile::Function && !rp.bc.velocityFunction),
+        "fluid: patch '" << rp.name << "': profile 'function' needs a velocity function");
     MFSI_CHECK(!(rp.bc.timeFunction.kind != TimeFunction::Kind::Constant &&
                  rp.bc.timeFunction.kind != TimeFunction::Kind::Function && !(rp.bc.timeFunction.period > 0)),
                "fluid: patch '" << rp.name << "': time function period must be positive");
@@ -110,8 +126,8 @@ BoundaryConditions::BoundaryConditions(const HexMesh& mesh, const FluidOptions& 
       MFSI_CHECK(tf.pulseDuration >= 0 && tf.pulseDuration <= tf.period,
                  "fluid: patch '" << rp.name << "': half-power sine pulse duration " << tf.pulseDuration
                                   << " must be in (0, period = " << tf.period << "] (0: period / 2)");
-      MFSI_CHECK(tf.exponent > 0, "fluid: patch '" << rp.name << "': half-power sine exponent must be positive, got "
-                                                   << tf.exponent);
+      MFSI_CHECK(tf.exponent > 0,
+                 "fluid: patch '" << rp.name << "': half-power sine exponent must be positive, got " << tf.exponent);
     }
     if (rp.type == BoundaryType::FixedPressure || rp.type == BoundaryType::Resistance) fixesPressure_ = true;
     // Bounding box of the patch nodes (reference configuration).
@@ -206,7 +222,8 @@ void BoundaryConditions::update(const ExecSpace& exec, real t, const MeshGeometr
         rp.currentPressure = rp.bc.resistance * rp.currentFlowRate + ft * rp.bc.pressure;
         for (lid_t f = rp.start; f < rp.start + rp.size; ++f) hPressure_(f - nIn_) = rp.currentPressure;
         break;
-      default: break;
+      default:
+        break;
     }
   }
   Kokkos::deep_copy(exec, velocity_, hVelocity_);

@@ -15,9 +15,11 @@ const std::vector<std::string> kBoundaryTypes = {"fixedVelocity", "flowRate", "w
                                                  "slip",          "empty",    "fixedPressure", "resistance"};
 
 Schema linearSolverSchema(const std::string& what, double tolerance, int maxIter) {
-  return Schema::map(what + " linear solver: stops at scaled residual < tolerance, residual reduced by relTol, or maxIter")
+  return Schema::map(what +
+                     " linear solver: stops at scaled residual < tolerance, residual reduced by relTol, or maxIter")
       .key("tolerance", Schema::real("absolute tolerance on the scaled residual", "-").atLeast(0), Default(tolerance))
-      .key("relTol", Schema::real("relative reduction of the residual (0: off)", "-").atLeast(0).lessThan(1), Default(0.0))
+      .key("relTol", Schema::real("relative reduction of the residual (0: off)", "-").atLeast(0).lessThan(1),
+           Default(0.0))
       .key("maxIter", Schema::integer("iteration limit per solve").atLeast(1), Default(maxIter));
 }
 
@@ -30,26 +32,31 @@ Schema boundarySchema() {
                           "fixedPressure: p prescribed, zero-gradient velocity (outflow); resistance: p = resistance * "
                           "q + pressure, q the outflow rate",
                           kBoundaryTypes))
-      .key("velocity", Schema::realVector(3, "fixedVelocity: value (peak of a parabolic profile); wall: wall velocity", "m/s"),
+      .key("velocity",
+           Schema::realVector(3, "fixedVelocity: value (peak of a parabolic profile); wall: wall velocity", "m/s"),
            Default(std::array<double, 3>{0, 0, 0}))
       .key("flowRate", Schema::real("flowRate: volumetric inflow, positive into the domain", "m^3/s"), Default(0.0))
       .key("pressure", Schema::real("fixedPressure: p; resistance: p0", "Pa"), Default(0.0))
       .key("resistance", Schema::real("resistance: C_r", "Pa s/m^3").atLeast(0), Default(0.0))
-      .key("profile", Schema::choice("fixedVelocity/flowRate: shape across the patch; parabolic = prod 4 s (1 - s)",
-                                     {"uniform", "parabolic"}),
+      .key("profile",
+           Schema::choice("fixedVelocity/flowRate: shape across the patch; parabolic = prod 4 s (1 - s)",
+                          {"uniform", "parabolic"}),
            Default("uniform"))
-      .key("parabolicAxes", Schema::list("parabolic: axes the profile varies across", Schema::choice("axis", {"x", "y", "z"})),
+      .key("parabolicAxes",
+           Schema::list("parabolic: axes the profile varies across", Schema::choice("axis", {"x", "y", "z"})),
            Presence::Optional)
-      .key("parabolicMin", Schema::realVector(3, "parabolic: lower end of the extent per axis (min >= max: patch box)", "m"),
+      .key("parabolicMin",
+           Schema::realVector(3, "parabolic: lower end of the extent per axis (min >= max: patch box)", "m"),
            Default(std::array<double, 3>{0, 0, 0}))
       .key("parabolicMax", Schema::realVector(3, "parabolic: upper end of the extent per axis", "m"),
            Default(std::array<double, 3>{0, 0, 0}))
       .key("timeFunction",
            Schema::map("factor f(t) on the velocity, flow rate or pressure")
-               .key("type", Schema::choice("constant: 1; oneMinusCos: 1 - cos(2 pi t / period); cosineRamp: (1 - cos(pi t "
-                                           "/ period)) / 2 up to t = period, then 1; halfPowerSine: sin(pi tau / "
-                                           "pulseDuration)^exponent for tau = t mod period < pulseDuration, else 0",
-                                           {"constant", "oneMinusCos", "cosineRamp", "halfPowerSine"}),
+               .key("type",
+                    Schema::choice("constant: 1; oneMinusCos: 1 - cos(2 pi t / period); cosineRamp: (1 - cos(pi t "
+                                   "/ period)) / 2 up to t = period, then 1; halfPowerSine: sin(pi tau / "
+                                   "pulseDuration)^exponent for tau = t mod period < pulseDuration, else 0",
+                                   {"constant", "oneMinusCos", "cosineRamp", "halfPowerSine"}),
                     Default("constant"))
                .key("period", Schema::real("period or ramp time", "s").greaterThan(0), Default(1.0))
                .key("pulseDuration", Schema::real("halfPowerSine: pulse length (0: period / 2)", "s").atLeast(0),
@@ -62,8 +69,8 @@ Schema forceSchema() {
   return Schema::map("force and moment on a patch (or both sides of a baffle), metrics fluid.<patch>.*")
       .key("patch", Schema::string("patch or baffle name"))
       .key("point", Schema::realVector(3, "moment reference point", "m"), Default(std::array<double, 3>{0, 0, 0}))
-      .key("referenceVelocity", Schema::real("U of the coefficients c = 2 F.e / (rho U^2 A) (0: no coefficients)", "m/s")
-                                    .atLeast(0),
+      .key("referenceVelocity",
+           Schema::real("U of the coefficients c = 2 F.e / (rho U^2 A) (0: no coefficients)", "m/s").atLeast(0),
            Default(0.0))
       .key("referenceArea", Schema::real("A of the coefficients", "m^2").greaterThan(0), Default(1.0))
       .key("dragDirection", Schema::realVector(3, "direction e of c_D", "-"), Default(std::array<double, 3>{1, 0, 0}))
@@ -125,10 +132,10 @@ PatchBC readBoundary(const SceneConfig& b) {
   bc.parabolicMax = vec3(b, "parabolicMax");
   if (b.has("timeFunction")) {
     const std::string tf = b.get<std::string>("timeFunction.type");
-    bc.timeFunction.kind = tf == "oneMinusCos"  ? TimeFunction::Kind::OneMinusCos
-                           : tf == "cosineRamp" ? TimeFunction::Kind::CosineRamp
+    bc.timeFunction.kind = tf == "oneMinusCos"     ? TimeFunction::Kind::OneMinusCos
+                           : tf == "cosineRamp"    ? TimeFunction::Kind::CosineRamp
                            : tf == "halfPowerSine" ? TimeFunction::Kind::HalfPowerSine
-                                                : TimeFunction::Kind::Constant;
+                                                   : TimeFunction::Kind::Constant;
     bc.timeFunction.period = b.get<double>("timeFunction.period");
     bc.timeFunction.pulseDuration = b.get<double>("timeFunction.pulseDuration");
     bc.timeFunction.exponent = b.get<double>("timeFunction.exponent");
@@ -144,25 +151,30 @@ Schema fluidSchema() {
   const FluidOptions d;  // defaults below mirror these
   Schema pimple =
       Schema::map("pressure-velocity coupling: PIMPLE per time step; SIMPLE iterations when steady")
-          .key("outerCorrectors", Schema::integer("outer iterations per step (SIMPLE iterations per step when steady)").atLeast(1),
+          .key("outerCorrectors",
+               Schema::integer("outer iterations per step (SIMPLE iterations per step when steady)").atLeast(1),
                Default(d.pimple.nOuterCorrectors))
           .key("correctors", Schema::integer("pressure correctors per outer iteration (PISO)").atLeast(1),
                Default(d.pimple.nCorrectors))
-          .key("nonOrthogonalCorrectors", Schema::integer("extra pressure solves for the non-orthogonal correction").atLeast(0),
+          .key("nonOrthogonalCorrectors",
+               Schema::integer("extra pressure solves for the non-orthogonal correction").atLeast(0),
                Default(d.pimple.nNonOrthogonalCorrectors))
           .key("momentumPredictor", Schema::boolean("solve the momentum equation before the pressure correctors"),
                Default(d.pimple.momentumPredictor))
           .key("outerTolerance",
-               Schema::real("stop the outer loop when the initial momentum and pressure residuals drop below (0: off)", "-")
+               Schema::real("stop the outer loop when the initial momentum and pressure residuals drop below (0: off)",
+                            "-")
                    .atLeast(0),
                Default(d.pimple.outerTolerance))
-          .key("relaxVelocity", Schema::real("implicit under-relaxation of momentum (~0.7-0.9 when steady)", "-")
-                                    .greaterThan(0)
-                                    .atMost(1),
+          .key("relaxVelocity",
+               Schema::real("implicit under-relaxation of momentum (~0.7-0.9 when steady)", "-")
+                   .greaterThan(0)
+                   .atMost(1),
                Default(d.pimple.relaxVelocity))
-          .key("relaxPressure", Schema::real("explicit under-relaxation of pressure (~0.2-0.3 when steady)", "-")
-                                    .greaterThan(0)
-                                    .atMost(1),
+          .key("relaxPressure",
+               Schema::real("explicit under-relaxation of pressure (~0.2-0.3 when steady)", "-")
+                   .greaterThan(0)
+                   .atMost(1),
                Default(d.pimple.relaxPressure))
           .key("ddtCorrection", Schema::boolean("Rhie-Chow correction of the time-derivative term"),
                Default(d.pimple.ddtCorrection))
@@ -171,15 +183,21 @@ Schema fluidSchema() {
                                "pressure solve from the last step's final-corrector change (initial guesses only)"),
                Default(d.pimple.extrapolateGuess));
   Schema pressure = linearSolverSchema("pressure", d.pressureSolver.tolerance, d.pressureSolver.maxIter);
-  pressure.key("finalRelTol", Schema::real("relTol of the last pressure solve of a step (pFinal; < 0: relTol)", "-").lessThan(1),
-               Default(d.pressureFinalRelTol))
+  pressure
+      .key("finalRelTol",
+           Schema::real("relTol of the last pressure solve of a step (pFinal; < 0: relTol)", "-").lessThan(1),
+           Default(d.pressureFinalRelTol))
       .key("preconditioner", Schema::choice("conjugate-gradient preconditioner", {"amg", "jacobi"}), Default("amg"))
-      .key("preconditionerRefresh", Schema::integer("most outer iterations between AMG value refreshes (earlier when the final pressure solve needs 25 % more iterations than after the last refresh)").atLeast(1),
+      .key("preconditionerRefresh",
+           Schema::integer("most outer iterations between AMG value refreshes (earlier when the final pressure solve "
+                           "needs 25 % more iterations than after the last refresh)")
+               .atLeast(1),
            Default(d.pressurePreconditionerRefresh));
-  Schema solvers = Schema::map("linear solvers")
-                       .key("pressure", pressure, Presence::Optional)
-                       .key("momentum", linearSolverSchema("momentum", d.momentumSolver.tolerance, d.momentumSolver.maxIter),
-                            Presence::Optional);
+  Schema solvers =
+      Schema::map("linear solvers")
+          .key("pressure", pressure, Presence::Optional)
+          .key("momentum", linearSolverSchema("momentum", d.momentumSolver.tolerance, d.momentumSolver.maxIter),
+               Presence::Optional);
   return Schema::map("incompressible Navier-Stokes on the scene mesh (finite volumes, PIMPLE/SIMPLE)")
       .key("density", Schema::real("density rho", "kg/m^3").greaterThan(0), Default(d.density))
       .key("viscosity", Schema::real("dynamic viscosity mu (give this or nu)", "Pa s").greaterThan(0),
@@ -191,34 +209,39 @@ Schema fluidSchema() {
            Schema::real("artificial compressibility: (1/(rho c^2)) dp/dt + div u = 0; 0 = incompressible", "m/s")
                .atLeast(0),
            Default(d.artificialCompressibility.soundSpeed))
-      .key("timeScheme", Schema::choice("steady: SIMPLE; euler: implicit Euler; bdf2: second-order backward differences",
-                                        {"steady", "euler", "bdf2"}),
+      .key("timeScheme",
+           Schema::choice("steady: SIMPLE; euler: implicit Euler; bdf2: second-order backward differences",
+                          {"steady", "euler", "bdf2"}),
            Default("bdf2"))
-      .key("convection", Schema::choice("face interpolation of the convected velocity", {"upwind", "linear", "limitedLinear",
-                                                                                          "vanLeer"}),
+      .key("convection",
+           Schema::choice("face interpolation of the convected velocity",
+                          {"upwind", "linear", "limitedLinear", "vanLeer"}),
            Default("linear"))
       .key("gradient", Schema::choice("cell gradients", {"gaussLinear", "leastSquares"}), Default("gaussLinear"))
       .key("pimple", pimple, Presence::Optional)
       .key("solvers", solvers, Presence::Optional)
-      .key("initial", Schema::map("initial fields")
-                          .key("velocity", Schema::realVector(3, "uniform initial velocity", "m/s"),
-                               Default(std::array<double, 3>{0, 0, 0}))
-                          .key("pressure", Schema::real("uniform initial pressure", "Pa"), Default(0.0)),
+      .key("initial",
+           Schema::map("initial fields")
+               .key("velocity", Schema::realVector(3, "uniform initial velocity", "m/s"),
+                    Default(std::array<double, 3>{0, 0, 0}))
+               .key("pressure", Schema::real("uniform initial pressure", "Pa"), Default(0.0)),
            Presence::Optional)
-      .key("boundary", Schema::freeMap("condition per patch name; wall, symmetry, empty and baffle patches may be omitted "
-                                       "(wall -> wall, symmetry -> slip, empty -> empty, baffle -> wall moved by a membrane)",
-                                       boundarySchema()),
+      .key("boundary",
+           Schema::freeMap("condition per patch name; wall, symmetry, empty and baffle patches may be omitted "
+                           "(wall -> wall, symmetry -> slip, empty -> empty, baffle -> wall moved by a membrane)",
+                           boundarySchema()),
            Presence::Optional)
       .key("forces", Schema::list("patches whose force and moment are reported", forceSchema()), Presence::Optional)
       .key("pressureDifferences", Schema::list("pressure differences reported as metrics", pressureDifferenceSchema()),
            Presence::Optional)
-      .key("ghia", Schema::map("compare a lid-driven cavity (mesh bounding box in x, y; lid at y max moving in +x) with "
-                               "Ghia, Ghia & Shin (1982): metrics fluid.ghia_u_max_err, fluid.ghia_v_max_err")
-                       .key("enabled", Schema::boolean("compute the comparison (false: skip, e.g. at another Re)"),
-                            Default(true))
-                       .key("re", Schema::choice("Reynolds number of the table; must equal rho U L / mu of the scene", {"100"}),
-                            Default("100"))
-                       .key("lidSpeed", Schema::real("lid speed U", "m/s").greaterThan(0), Default(1.0)),
+      .key("ghia",
+           Schema::map("compare a lid-driven cavity (mesh bounding box in x, y; lid at y max moving in +x) with "
+                       "Ghia, Ghia & Shin (1982): metrics fluid.ghia_u_max_err, fluid.ghia_v_max_err")
+               .key("enabled", Schema::boolean("compute the comparison (false: skip, e.g. at another Re)"),
+                    Default(true))
+               .key("re", Schema::choice("Reynolds number of the table; must equal rho U L / mu of the scene", {"100"}),
+                    Default("100"))
+               .key("lidSpeed", Schema::real("lid speed U", "m/s").greaterThan(0), Default(1.0)),
            Presence::OptionalSection);
 }
 
@@ -227,9 +250,10 @@ FluidOptions readFluidOptions(const SceneConfig& c, const HexMesh& mesh) {
   o.density = c.get<double>("density");
   const bool hasMu = c.has("viscosity"), hasNu = c.has("nu");
   if (hasMu == hasNu)
-    throw InputError(c.where(hasMu ? "nu" : ""), hasMu ? "give either 'viscosity' (dynamic) or 'nu' (kinematic), not both"
-                                                        : "give the viscosity: 'viscosity' (dynamic, Pa s) or 'nu' "
-                                                          "(kinematic, m^2/s)");
+    throw InputError(c.where(hasMu ? "nu" : ""), hasMu
+                                                     ? "give either 'viscosity' (dynamic) or 'nu' (kinematic), not both"
+                                                     : "give the viscosity: 'viscosity' (dynamic, Pa s) or 'nu' "
+                                                       "(kinematic, m^2/s)");
   o.viscosity = hasMu ? c.get<double>("viscosity") : c.get<double>("nu") * o.density;
   o.bodyForce = vec3(c, "bodyForce");
   o.artificialCompressibility.soundSpeed = c.get<double>("artificialSoundSpeed");
@@ -240,7 +264,8 @@ FluidOptions readFluidOptions(const SceneConfig& c, const HexMesh& mesh) {
                  : cs == "limitedLinear" ? ConvectionScheme::LimitedLinear
                  : cs == "vanLeer"       ? ConvectionScheme::VanLeer
                                          : ConvectionScheme::Linear;
-  o.gradient = c.get<std::string>("gradient") == "leastSquares" ? GradientScheme::LeastSquares : GradientScheme::GaussLinear;
+  o.gradient =
+      c.get<std::string>("gradient") == "leastSquares" ? GradientScheme::LeastSquares : GradientScheme::GaussLinear;
 
   o.pimple.nOuterCorrectors = c.get<int>("pimple.outerCorrectors");
   o.pimple.nCorrectors = c.get<int>("pimple.correctors");
@@ -253,7 +278,8 @@ FluidOptions readFluidOptions(const SceneConfig& c, const HexMesh& mesh) {
   o.pimple.extrapolateGuess = c.get<bool>("pimple.extrapolateGuess");
 
   auto solver = [&](const std::string& k) {
-    return LinearSolverOptions{c.get<double>(k + ".tolerance"), c.get<double>(k + ".relTol"), c.get<int>(k + ".maxIter")};
+    return LinearSolverOptions{c.get<double>(k + ".tolerance"), c.get<double>(k + ".relTol"),
+                               c.get<int>(k + ".maxIter")};
   };
   o.pressureSolver = solver("solvers.pressure");
   o.momentumSolver = solver("solvers.momentum");
@@ -291,7 +317,8 @@ FluidReports readFluidReports(const SceneConfig& c, const HexMesh& mesh, const F
     fr.liftDirection = vec3(f, "liftDirection");
     for (Vec3* e : {&fr.dragDirection, &fr.liftDirection}) {
       const double n = std::sqrt((*e)[0] * (*e)[0] + (*e)[1] * (*e)[1] + (*e)[2] * (*e)[2]);
-      if (!(n > 0)) throw InputError(f.where(e == &fr.dragDirection ? "dragDirection" : "liftDirection"), "must be non-zero");
+      if (!(n > 0))
+        throw InputError(f.where(e == &fr.dragDirection ? "dragDirection" : "liftDirection"), "must be non-zero");
       for (auto& x : *e) x /= n;
     }
     r.forces.push_back(fr);
@@ -306,7 +333,8 @@ FluidReports readFluidReports(const SceneConfig& c, const HexMesh& mesh, const F
     if (!pr.patch.empty() && mesh.findPatch(pr.patch) < 0) {
       std::vector<std::string> names;
       for (const auto& mp : mesh.patches()) names.push_back(mp.name);
-      throw InputError(p.where("patch"), "the mesh has no patch named '" + pr.patch + "'" + didYouMean(pr.patch, names));
+      throw InputError(p.where("patch"),
+                       "the mesh has no patch named '" + pr.patch + "'" + didYouMean(pr.patch, names));
     }
     r.pressureDifferences.push_back(pr);
   }

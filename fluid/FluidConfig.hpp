@@ -45,7 +45,7 @@ fluid::FluidOptions readFluidOptions(const SceneConfig& fluidSection, const HexM
 /// c = 2 F.e / (rho U^2 A) along the drag and lift directions when `referenceVelocity` > 0.
 struct ForceReport {
   std::string patch;
-  fluid::Vec3 point{0, 0, 0};  ///< moment reference point [m]
+  fluid::Vec3 point{0, 0, 0};    ///< moment reference point [m]
   double referenceVelocity = 0;  ///< U [m/s]; 0: no coefficients
   double referenceArea = 1;      ///< A [m^2]
   fluid::Vec3 dragDirection{1, 0, 0};

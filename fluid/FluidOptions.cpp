@@ -8,10 +8,14 @@ namespace mfsi::fluid {
 real TimeFunction::operator()(real t) const {
   const real pi = 3.14159265358979323846;
   switch (kind) {
-    case Kind::Constant: return 1.0;
-    case Kind::OneMinusCos: return 1.0 - std::cos(2.0 * pi * t / period);
-    case Kind::CosineRamp: return t < period ? 0.5 * (1.0 - std::cos(pi * t / period)) : 1.0;
-    case Kind::Function: return fn ? fn(t) : 1.0;
+    case Kind::Constant:
+      return 1.0;
+    case Kind::OneMinusCos:
+      return 1.0 - std::cos(2.0 * pi * t / period);
+    case Kind::CosineRamp:
+      return t < period ? 0.5 * (1.0 - std::cos(pi * t / period)) : 1.0;
+    case Kind::Function:
+      return fn ? fn(t) : 1.0;
     case Kind::HalfPowerSine: {
       const real tp = pulseDuration > 0 ? pulseDuration : 0.5 * period;
       real tau = std::fmod(t, period);
@@ -26,33 +30,48 @@ real TimeFunction::operator()(real t) const {
 
 const char* toString(TimeScheme s) {
   switch (s) {
-    case TimeScheme::Steady: return "steady";
-    case TimeScheme::Euler: return "Euler";
-    case TimeScheme::BDF2: return "BDF2";
+    case TimeScheme::Steady:
+      return "steady";
+    case TimeScheme::Euler:
+      return "Euler";
+    case TimeScheme::BDF2:
+      return "BDF2";
   }
   return "?";
 }
 
 const char* toString(ConvectionScheme s) {
   switch (s) {
-    case ConvectionScheme::Upwind: return "upwind";
-    case ConvectionScheme::Linear: return "linear";
-    case ConvectionScheme::LimitedLinear: return "limitedLinear";
-    case ConvectionScheme::VanLeer: return "vanLeer";
+    case ConvectionScheme::Upwind:
+      return "upwind";
+    case ConvectionScheme::Linear:
+      return "linear";
+    case ConvectionScheme::LimitedLinear:
+      return "limitedLinear";
+    case ConvectionScheme::VanLeer:
+      return "vanLeer";
   }
   return "?";
 }
 
 const char* toString(BoundaryType t) {
   switch (t) {
-    case BoundaryType::Auto: return "auto";
-    case BoundaryType::FixedVelocity: return "fixedVelocity";
-    case BoundaryType::FlowRate: return "flowRate";
-    case BoundaryType::Wall: return "wall";
-    case BoundaryType::Slip: return "slip";
-    case BoundaryType::Empty: return "empty";
-    case BoundaryType::FixedPressure: return "fixedPressure";
-    case BoundaryType::Resistance: return "resistance";
+    case BoundaryType::Auto:
+      return "auto";
+    case BoundaryType::FixedVelocity:
+      return "fixedVelocity";
+    case BoundaryType::FlowRate:
+      return "flowRate";
+    case BoundaryType::Wall:
+      return "wall";
+    case BoundaryType::Slip:
+      return "slip";
+    case BoundaryType::Empty:
+      return "empty";
+    case BoundaryType::FixedPressure:
+      return "fixedPressure";
+    case BoundaryType::Resistance:
+      return "resistance";
   }
   return "?";
 }

@@ -106,9 +106,9 @@ struct PatchBC {
   Vec3 parabolicMin{0, 0, 0};
   Vec3 parabolicMax{0, 0, 0};
   std::function<Vec3(const Vec3& x, real t)> velocityFunction;  ///< Profile::Function
-  real flowRate = 0;    ///< FlowRate: volumetric inflow [m^3/s] (positive into the domain)
-  real pressure = 0;    ///< FixedPressure: p; Resistance: p0 [Pa]
-  real resistance = 0;  ///< Resistance: C_r [Pa s / m^3]
+  real flowRate = 0;          ///< FlowRate: volumetric inflow [m^3/s] (positive into the domain)
+  real pressure = 0;          ///< FixedPressure: p; Resistance: p0 [Pa]
+  real resistance = 0;        ///< Resistance: C_r [Pa s / m^3]
   TimeFunction timeFunction;  ///< multiplies the velocity, flow rate or pressure
   WallMotion wallMotion = WallMotion::Fixed;
 };
@@ -129,9 +129,9 @@ struct LinearSolverOptions {
 
 /// \brief Pressure-velocity coupling (PIMPLE; with TimeScheme::Steady it is SIMPLE).
 struct PimpleOptions {
-  int nOuterCorrectors = 1;         ///< outer iterations per step (SIMPLE iterations when steady)
-  int nCorrectors = 2;              ///< pressure correctors per outer iteration (PISO)
-  int nNonOrthogonalCorrectors = 0; ///< extra pressure solves for the explicit non-orthogonal correction
+  int nOuterCorrectors = 1;          ///< outer iterations per step (SIMPLE iterations when steady)
+  int nCorrectors = 2;               ///< pressure correctors per outer iteration (PISO)
+  int nNonOrthogonalCorrectors = 0;  ///< extra pressure solves for the explicit non-orthogonal correction
   bool momentumPredictor = true;
   /// Outer loop stops early when the initial residuals of momentum and pressure drop below this.
   real outerTolerance = 0.0;
@@ -164,8 +164,8 @@ struct ArtificialCompressibilityOptions {
 
 /// \brief All options of `FluidSolver`.
 struct FluidOptions {
-  real density = 1.0;    ///< rho [kg/m^3]
-  real viscosity = 0.01; ///< dynamic viscosity mu [Pa s]
+  real density = 1.0;       ///< rho [kg/m^3]
+  real viscosity = 0.01;    ///< dynamic viscosity mu [Pa s]
   Vec3 bodyForce{0, 0, 0};  ///< body acceleration g [m/s^2]
   TimeScheme timeScheme = TimeScheme::BDF2;
   ConvectionScheme convection = ConvectionScheme::Linear;

@@ -47,15 +47,15 @@ struct StepResult {
   bool ok = true;          ///< false on NaN/Inf or a linear-solver breakdown
   bool converged = false;  ///< outer loop reached `outerTolerance` (always false when it is 0)
   int outerIterations = 0;
-  int momentumIterations = 0;   ///< linear iterations, summed
-  int pressureIterations = 0;   ///< linear iterations, summed
-  real momentumResidual = 0;    ///< initial (normalised) residual of the first momentum solve
-  real pressureResidual = 0;    ///< initial residual of the first pressure solve
+  int momentumIterations = 0;      ///< linear iterations, summed
+  int pressureIterations = 0;      ///< linear iterations, summed
+  real momentumResidual = 0;       ///< initial (normalised) residual of the first momentum solve
+  real pressureResidual = 0;       ///< initial residual of the first pressure solve
   real finalMomentumResidual = 0;  ///< initial residual of the momentum solve of the last outer iteration
   real finalPressureResidual = 0;  ///< initial residual of the first pressure solve of the last outer iteration
-  real continuityMax = 0;  ///< max over cells of |sum_f phi_f| / V  [1/s] after the last corrector
-                           ///< (with artificial compressibility: the compression rate, not a residual)
-  real continuitySum = 0;  ///< sum over cells of |sum_f phi_f|  [m^3/s]
+  real continuityMax = 0;          ///< max over cells of |sum_f phi_f| / V  [1/s] after the last corrector
+                                   ///< (with artificial compressibility: the compression rate, not a residual)
+  real continuitySum = 0;          ///< sum over cells of |sum_f phi_f|  [m^3/s]
 };
 
 /// \brief Node positions at time t; called by `solveStep` when set with `setMeshMotion`.
@@ -199,12 +199,12 @@ class FluidSolver {
   Real3View b3_;
   // Face fields.
   RealView phi_, meshPhi_, phiHbyA_, dphi_, dphi0_, dphi00_, sweptNew_, sweptOld_, fluxP_;
-  RealView coefP_;  ///< pressure-matrix face coefficients from pressureSourceFlux (fused path)
+  RealView coefP_;   ///< pressure-matrix face coefficients from pressureSourceFlux (fused path)
   Real3View fluxU_;  ///< like phiHbyA_, allocated by the face path that needs it
   // Boundary-face fields.
   Real3View Ub_, faceMeshVel_;
   RealView pb_;
-  IndexView boundaryCells_;  ///< cells owning a boundary face
+  IndexView boundaryCells_;      ///< cells owning a boundary face
   GradientStencil gradStencil_;  ///< Gauss-linear gradients (rebuilt with the geometry)
   // Mesh positions at the start of the step.
   Real3View points0_;
@@ -247,7 +247,7 @@ class FluidSolver {
   bool boundaryVelocityReadsU_ = true;
   /// gradU_ is what velocityGradient() promises (see there); false when the outer loop skipped it.
   mutable bool gradUCurrent_ = false;  ///< a resistance outlet changes the boundary pressure every corrector
-  real c1_ = 0, c0_ = 0, c00_ = 0;  ///< time weights: d(phi)/dt ~ (c1 phi - c0 phi0 + c00 phi00)/dt
+  real c1_ = 0, c0_ = 0, c00_ = 0;     ///< time weights: d(phi)/dt ~ (c1 phi - c0 phi0 + c00 phi00)/dt
   MeshMotion motion_;
 };
 

@@ -9,8 +9,10 @@ namespace mfsi::fluid {
 
 const char* toString(ReductionMode mode) {
   switch (mode) {
-    case ReductionMode::Gather: return "gather";
-    case ReductionMode::Scatter: return "scatter";
+    case ReductionMode::Gather:
+      return "gather";
+    case ReductionMode::Scatter:
+      return "scatter";
   }
   return "?";
 }

@@ -31,14 +31,14 @@ const char* toString(ReductionMode mode);
 /// the diagonal, and the maps that let face kernels find their matrix entries.
 struct FvSparsity {
   lid_t nRows = 0;
-  IndexView rowPtr;       ///< size nRows + 1
-  IndexView colIdx;       ///< sorted per row
-  IndexView diagIdx;      ///< position of the diagonal of each row
-  IndexView cellFacePos;  ///< per entry of mesh.cellFaces(): position of that face's off-diagonal in the
-                          ///< cell's row, -1 for boundary faces
-  IndexView ownerPos;     ///< per internal face: position of (owner, neighbour)
-  IndexView neighbourPos; ///< per internal face: position of (neighbour, owner)
-  CsrRowRuns runs;        ///< row runs of the sparsity (kernels/CsrMatrix.hpp)
+  IndexView rowPtr;        ///< size nRows + 1
+  IndexView colIdx;        ///< sorted per row
+  IndexView diagIdx;       ///< position of the diagonal of each row
+  IndexView cellFacePos;   ///< per entry of mesh.cellFaces(): position of that face's off-diagonal in the
+                           ///< cell's row, -1 for boundary faces
+  IndexView ownerPos;      ///< per internal face: position of (owner, neighbour)
+  IndexView neighbourPos;  ///< per internal face: position of (neighbour, owner)
+  CsrRowRuns runs;         ///< row runs of the sparsity (kernels/CsrMatrix.hpp)
 };
 
 /// \brief Build the sparsity of `mesh` (host-side build, copied to the device; once per topology).
@@ -68,13 +68,14 @@ void assembleMatrix(const ExecSpace& exec, const HexMesh& mesh, const FvSparsity
 
 namespace detail {
 template <class V>
-KOKKOS_INLINE_FUNCTION std::enable_if_t<static_cast<int>(V::rank) == 1, typename V::reference_type> comp(
-    const V& v, lid_t i, int) {
+KOKKOS_INLINE_FUNCTION std::enable_if_t<static_cast<int>(V::rank) == 1, typename V::reference_type> comp(const V& v,
+                                                                                                         lid_t i, int) {
   return v(i);
 }
 template <class V>
-KOKKOS_INLINE_FUNCTION std::enable_if_t<static_cast<int>(V::rank) == 2, typename V::reference_type> comp(
-    const V& v, lid_t i, int k) {
+KOKKOS_INLINE_FUNCTION std::enable_if_t<static_cast<int>(V::rank) == 2, typename V::reference_type> comp(const V& v,
+                                                                                                         lid_t i,
+                                                                                                         int k) {
   return v(i, k);
 }
 }  // namespace detail

@@ -52,8 +52,8 @@ double interpLinear(const std::vector<double>& x, const std::vector<double>& y, 
 // of `crossAxis`): one sample per cell row, interpolated linearly across the line between the
 // nearest centroids on either side. Rows are cells with equal `lineAxis` centroid coordinate.
 template <class CView, class UView>
-void centreline(const CView& C, const UView& U, int lineAxis, int crossAxis, int comp,
-                double mid, double tol, std::vector<double>& pos, std::vector<double>& val) {
+void centreline(const CView& C, const UView& U, int lineAxis, int crossAxis, int comp, double mid, double tol,
+                std::vector<double>& pos, std::vector<double>& val) {
   std::map<long long, std::vector<int>> rows;  // keyed by the rounded row coordinate
   for (int c = 0; c < static_cast<int>(C.extent(0)); ++c) rows[std::llround(C(c, lineAxis) / tol)].push_back(c);
   for (const auto& [key, cells] : rows) {

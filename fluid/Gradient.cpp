@@ -8,13 +8,12 @@ namespace mfsi::fluid {
 namespace {
 
 template <class G>
-KOKKOS_INLINE_FUNCTION std::enable_if_t<static_cast<int>(G::rank) == 2> store(const G& g, lid_t c, int i, int,
-                                                                                 real v) {
+KOKKOS_INLINE_FUNCTION std::enable_if_t<static_cast<int>(G::rank) == 2> store(const G& g, lid_t c, int i, int, real v) {
   g(c, i) = v;
 }
 template <class G>
 KOKKOS_INLINE_FUNCTION std::enable_if_t<static_cast<int>(G::rank) == 3> store(const G& g, lid_t c, int i, int j,
-                                                                                 real v) {
+                                                                              real v) {
   g(c, i, j) = v;
 }
 

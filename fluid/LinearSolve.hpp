@@ -62,13 +62,20 @@ class LinearSolver {
   /// \brief Solve the (symmetric positive definite) pressure system A x = b.
   LinearSolveStats solvePressure(const ExecSpace& exec, const CsrMatrix& A, const ConstRealView& b, const RealView& x,
                                  const LinearSolverOptions& o);
+  /// \brief The multiple s of d that minimises the energy norm of the error of x + s d for the
+  /// symmetric positive definite pressure system A x = b: s = d.(b - A x) / d.A d (one Galerkin
+  /// step along d; 0 when d.A d is not positive or a sum is not finite). x and d are not changed.
+  /// One pass over A (symmetry gives d.(A x) = (A d).x); on CG's lattice copy when A has one.
+  real pressureStepAlong(const ExecSpace& exec, const CsrMatrix& A, const ConstRealView& b, const ConstRealView& x,
+                         const ConstRealView& d);
 
  private:
   LinearSolveStats solve(const ExecSpace& exec, KrylovSolver& solver, Preconditioner& M, const CsrMatrix& A,
                          const ConstRealView& b, const RealView& x, const LinearSolverOptions& o);
 
   std::unique_ptr<Preconditioner> uPrec_, pPrec_;
-  std::unique_ptr<KrylovSolver> uSolver_, pSolver_;
+  std::unique_ptr<KrylovSolver> uSolver_;
+  std::unique_ptr<ConjugateGradient> pSolver_;
   BiCGStab3 u3Solver_;
   RealView uInvDiag_;  ///< Jacobi of the momentum matrix, shared by uPrec_ and u3Solver_
   bool uReady_ = false, pReady_ = false;

@@ -61,8 +61,8 @@ PatchLoads patchLoads(const FluidSolver& fluid, const std::string& name, const V
     real r[10] = {0, 0, 0, 0, 0, 0, 0, 0, 0, 0};
     Kokkos::parallel_reduce(
         "mfsi::fluid::loads::patchSum", RangePolicy(ExecSpace(), 0, p.size),
-        KOKKOS_LAMBDA(lid_t k, real & a0, real & a1, real & a2, real & a3, real & a4, real & a5, real & a6,
-                      real & a7, real & a8, real & a9) {
+        KOKKOS_LAMBDA(lid_t k, real & a0, real & a1, real & a2, real & a3, real & a4, real & a5, real & a6, real & a7,
+                      real & a8, real & a9) {
           const lid_t f = start + k;
           const real A = sm(f);
           const real fp[3] = {tp(k, 0) * A, tp(k, 1) * A, tp(k, 2) * A};
@@ -98,9 +98,9 @@ void baffleNetPressure(const FluidSolver& fluid, const std::string& baffle, cons
   MFSI_CHECK(m >= 0 && s >= 0, "fluid: baffleNetPressure: no baffle named '" << baffle << "'");
   const auto& pm = mesh.patches()[m];
   const auto& ps = mesh.patches()[s];
-  MFSI_CHECK(static_cast<lid_t>(pNet.extent(0)) == pm.size,
-             "fluid: baffleNetPressure: baffle '" << baffle << "' has " << pm.size << " faces, view has "
-                                                  << pNet.extent(0));
+  MFSI_CHECK(static_cast<lid_t>(pNet.extent(0)) == pm.size, "fluid: baffleNetPressure: baffle '"
+                                                                << baffle << "' has " << pm.size << " faces, view has "
+                                                                << pNet.extent(0));
   const lid_t m0 = pm.start - mesh.nInternalFaces(), s0 = ps.start - mesh.nInternalFaces();
   ConstRealView pb = fluid.boundaryPressure();
   Kokkos::parallel_for(

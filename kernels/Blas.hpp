@@ -64,6 +64,18 @@ struct Sums {
   KOKKOS_INLINE_FUNCTION const double& operator[](int k) const { return v[k]; }
 };
 
+/// \brief One row's terms of OpenFOAM's scaled residual, given b_i, (A x)_i and the row sum
+/// rs_i = sum_j a_ij: returns r_i = b_i - (A x)_i and adds {|r_i|, |ax - rs xbar| + |b - rs xbar|
+/// (the normalisation factor), |b| + |ax| (round-off scale), r_i^2} to acc[0..3].
+KOKKOS_INLINE_FUNCTION double scaledResidualTerms(double b, double ax, double rs, double xbar, Sums<4>& acc) {
+  const double r = b - ax;
+  acc[0] += kmath::fabs(r);
+  acc[1] += kmath::fabs(ax - rs * xbar) + kmath::fabs(b - rs * xbar);
+  acc[2] += kmath::fabs(b) + kmath::fabs(ax);
+  acc[3] += r * r;
+  return r;
+}
+
 /// \brief Lanes of `reduceLanes`: independent partial sums per block (see there).
 inline constexpr int kReductionLanes = 4;
 

@@ -136,6 +136,11 @@ class ConjugateGradient final : public KrylovSolver {
   void matrixChanged(const ExecSpace& exec, const CsrMatrix& A) override;
   /// \brief Whether a solve with A would use the lattice copy.
   bool usesLatticeCopy(const CsrMatrix& A) const { return lattice_.matches(A); }
+  /// \brief The lattice copy of A, or nullptr when a solve with A would not use one (callers
+  /// with more passes over A, e.g. initial residuals, use it too).
+  const SymmetricLatticeMatrix* latticeCopy(const CsrMatrix& A) const {
+    return lattice_.matches(A) ? &lattice_ : nullptr;
+  }
 
  private:
   KrylovResult run(const ExecSpace& exec, const CsrMatrix& A, const ConstRealView& b, const RealView& x,

@@ -24,6 +24,20 @@ KOKKOS_INLINE_FUNCTION double latticeRow(lid_t i, lid_t n, lid_t sy, lid_t sz, c
   return s;
 }
 
+/// Row sum of row i (the couplings in column order, as latticeRow).
+KOKKOS_INLINE_FUNCTION double latticeRowSum(lid_t i, lid_t n, lid_t sy, lid_t sz, const double* d, const double* ux,
+                                            const double* uy, const double* uz) {
+  double s = 0.0;
+  if (i >= sz) s += uz[i - sz];
+  if (i >= sy) s += uy[i - sy];
+  if (i >= 1) s += ux[i - 1];
+  s += d[i];
+  if (i + 1 < n) s += ux[i];
+  if (i + sy < n) s += uy[i];
+  if (i + sz < n) s += uz[i];
+  return s;
+}
+
 /// Host pointers of the lattice arrays and the strides (sz = n one cell thick).
 struct LatticePtrs {
   lid_t n = 0, sy = 0, sz = 0;
@@ -212,6 +226,21 @@ void SymmetricLatticeMatrix::spmv(const ExecSpace& exec, const ConstRealView& x,
         "mfsi::kernels::lattice::spmv", RangePolicy(exec, 0, n),
         KOKKOS_LAMBDA(lid_t i) { yp[i] = latticeRow(i, n, sy, sz, d, ux, uy, uz, xp); });
   }
+}
+
+std::array<double, 4> SymmetricLatticeMatrix::scaledResidual(const ExecSpace& exec, const SolverComm& comm,
+                                                             const ConstRealView& x, const ConstRealView& b,
+                                                             double xbar, const RealView& r) const {
+  const LatticePtrs P(nRows_, nx_, ny_, nz_, diag_, ux_, uy_, uz_);
+  const lid_t n = P.n, sy = P.sy, sz = P.sz;
+  const double *d = P.d, *ux = P.ux, *uy = P.uy, *uz = P.uz;
+  const double* xp = x.data();
+  return blas::reduce<4>(
+      exec, comm, "mfsi::kernels::lattice::scaledResidual", n, KOKKOS_LAMBDA(lid_t i, blas::Sums<4> & acc) {
+        const double ax = latticeRow(i, n, sy, sz, d, ux, uy, uz, xp);
+        const double rs = latticeRowSum(i, n, sy, sz, d, ux, uy, uz);
+        r(i) = blas::scaledResidualTerms(b(i), ax, rs, xbar, acc);
+      });
 }
 
 }  // namespace mfsi

@@ -64,6 +64,12 @@ class SymmetricLatticeMatrix {
   /// \brief y = A x on rows [0, n).
   void spmv(const ExecSpace& exec, const ConstRealView& x, const RealView& y) const;
 
+  /// \brief r = b - A x with the global sums of `blas::scaledResidualTerms` (OpenFOAM's scaled
+  /// residual about xbar; row sums of A from the copy). Row products and row sums in CSR column
+  /// order: the numbers of the CSR pass over the same matrix.
+  std::array<double, 4> scaledResidual(const ExecSpace& exec, const SolverComm& comm, const ConstRealView& x,
+                                       const ConstRealView& b, double xbar, const RealView& r) const;
+
   /// \brief Drop the copy and the references to the last matrix.
   void clear();
 

@@ -20,14 +20,14 @@ namespace {
 using mfsi::lid_t;
 using mfsi::fluid::LinearSolverOptions;
 using mfsi::fluid::LinearSolveStats;
-using mfsi::test::near;
-using mfsi::test::Tol;
 using mfsi::test::column;
 using mfsi::test::device;
 using mfsi::test::device3;
 using mfsi::test::host;
 using mfsi::test::HostVec;
+using mfsi::test::near;
 using mfsi::test::relDiff;
+using mfsi::test::Tol;
 
 /// The host CSR with OpenFOAM's residual scaling.
 struct HostCsr : mfsi::test::HostCsr {
@@ -297,9 +297,13 @@ TEST(LinearSolve, PressureSolveStopsOnTheScaledResidual) {
     x0[i] = 0.1 * std::cos(0.05 * i);
   }
   mfsi::ExecSpace exec;
-  for (auto pp : {mfsi::fluid::PressurePreconditioner::Jacobi, mfsi::fluid::PressurePreconditioner::Amg}) {
+  // Announced values: the scaled-residual pass runs on CG's lattice copy; not announced: on CSR.
+  for (auto [pp, announced] : {std::pair{mfsi::fluid::PressurePreconditioner::Jacobi, false},
+                               std::pair{mfsi::fluid::PressurePreconditioner::Amg, false},
+                               std::pair{mfsi::fluid::PressurePreconditioner::Amg, true}}) {
     mfsi::fluid::LinearSolver solver(A.nRows, pp);
     solver.pressureMatrixChanged(exec, A);
+    if (announced) solver.pressureValuesChanged(exec, A);
     const LinearSolverOptions o{1e-7, 0.0, 500};
     auto x = device(x0);
     const auto st = solver.solvePressure(exec, A, device(b), x, o);
@@ -313,4 +317,48 @@ TEST(LinearSolve, PressureSolveStopsOnTheScaledResidual) {
     solver.solvePressure(exec, A, device(b), xPrev, fewer);
     EXPECT_GT(hA.scaledResidual(b, host(xPrev), x0), 1e-7);
   }
+}
+
+TEST(LinearSolve, PressureStepAlongIsTheEnergyOptimalStep) {
+  // s = d.(b - A x) / d.A d against a host recomputation, on CSR and on CG's lattice copy (the
+  // same to rounding), and the energy norm of the error of x + s d is a minimum in s.
+  const auto A = mfsi::buildPoisson7({9, 8, 7}, mfsi::ModelBoundary::Dirichlet);
+  const HostCsr hA(A);
+  const lid_t n = A.nRows;
+  HostVec b(n), x(n), d(n);
+  for (lid_t i = 0; i < n; ++i) {
+    b[i] = std::sin(0.7 * i) + 0.3;
+    x[i] = 0.1 * std::cos(0.05 * i);
+    d[i] = std::cos(0.3 * i) - 0.2;
+  }
+  const HostVec ad = hA.apply(d), ax = hA.apply(x);
+  double num = 0, den = 0;
+  for (lid_t i = 0; i < n; ++i) {
+    num += d[i] * (b[i] - ax[i]);
+    den += d[i] * ad[i];
+  }
+  const double gold = num / den;
+  // Energy norm of the error of x + s d, up to a constant: E(s) = (x + s d).A(x + s d) / 2 - b.(x + s d).
+  auto energy = [&](double s) {
+    HostVec y(n);
+    for (lid_t i = 0; i < n; ++i) y[i] = x[i] + s * d[i];
+    const HostVec ay = hA.apply(y);
+    double e = 0;
+    for (lid_t i = 0; i < n; ++i) e += 0.5 * y[i] * ay[i] - b[i] * y[i];
+    return e;
+  };
+  mfsi::ExecSpace exec;
+  for (bool announced : {false, true}) {
+    mfsi::fluid::LinearSolver solver(n, mfsi::fluid::PressurePreconditioner::Amg);
+    solver.pressureMatrixChanged(exec, A);
+    if (announced) solver.pressureValuesChanged(exec, A);
+    const double s = solver.pressureStepAlong(exec, A, device(b), device(x), device(d));
+    EXPECT_TRUE(near(s, gold, Tol{0, 1e-12}, announced ? "lattice" : "csr"));
+    EXPECT_LT(energy(s), energy(s + 0.05 * std::abs(s)));
+    EXPECT_LT(energy(s), energy(s - 0.05 * std::abs(s)));
+  }
+  // No step along a zero direction.
+  mfsi::fluid::LinearSolver solver(n, mfsi::fluid::PressurePreconditioner::Amg);
+  solver.pressureMatrixChanged(exec, A);
+  EXPECT_EQ(solver.pressureStepAlong(exec, A, device(b), device(x), device(HostVec(n, 0.0))), 0.0);
 }
