@@ -127,8 +127,12 @@ struct MomentumRowKernel {
   bool withB = false;  ///< also the momentum solve's right-hand side b = rhs - V grad p
   ConstReal3View gp;
   Real3View b3;
+  /// When not empty: also the Jacobi inverse diagonal 1 / a_P of the momentum solve, with
+  /// invertDiagonal's formula and check (0 where a_P is zero or not finite; firstBad: the first
+  /// such row).
+  RealView inv;
 
-  KOKKOS_FORCEINLINE_FUNCTION void operator()(lid_t c) const {
+  KOKKOS_FORCEINLINE_FUNCTION void operator()(lid_t c, lid_t& firstBad) const {
     for (lid_t k = rowPtr(c); k < rowPtr(c + 1); ++k) vals(k) = 0.0;
     real diag = steady ? 0.0 : rho * c1 * V(c) * rdt;
     real src[3], bsum[3] = {0.0, 0.0, 0.0};
@@ -184,6 +188,12 @@ struct MomentumRowKernel {
     // Implicit under-relaxation: a_P -> a_P / alpha, source += (a_P / alpha - a_P) u_prev.
     const real ar = diag / alpha;
     vals(di(c)) = ar;
+    if (inv.extent(0) > 0) {
+      const real v = 1.0 / ar;
+      const bool ok = ar != 0.0 && v - v == 0.0;  // v - v != 0 for inf and NaN
+      inv(c) = ok ? v : 0.0;
+      if (!ok && c < firstBad) firstBad = c;
+    }
     for (int j = 0; j < 3; ++j) {
       const real r = (src[j] + -1.0 * bsum[j]) + (ar - diag) * U(c, j);
       rhs(c, j) = r;
@@ -638,15 +648,15 @@ ConstTensor3View FluidSolver::velocityGradient() const {
 // Momentum
 // ------------------------------------------------------------------------------------------------
 
-bool FluidSolver::assembleMomentum(bool withB) {
+FluidSolver::MomentumAssembly FluidSolver::assembleMomentum(bool withB, bool withInv) {
   ScopedRegion region("mfsi::fluid::momentum::assemble");
   const real rho = opt_.density, mu = opt_.viscosity;
   const ConvectionScheme scheme = opt_.convection;
   const bool implicitLinear = scheme == ConvectionScheme::Linear;
   const bool limited = scheme == ConvectionScheme::LimitedLinear || scheme == ConvectionScheme::VanLeer;
   if (opt_.fusedMomentumAssembly && !limited && !nonOrthogonal_ && opt_.reduction == ReductionMode::Gather) {
-    assembleMomentumFused(withB);
-    return withB;
+    assembleMomentumFused(withB, withInv);
+    return {withB, withInv};
   }
   // The per-face arrays of this path (~11 doubles per face) are allocated on first use: the
   // fused assembly, the usual one on orthogonal meshes, never reads them.
@@ -765,10 +775,10 @@ bool FluidSolver::assembleMomentum(bool withB) {
         vals(di(c)) = ar;
         for (int j = 0; j < 3; ++j) rhs(c, j) += (ar - a) * U(c, j);
       });
-  return false;
+  return {};
 }
 
-void FluidSolver::assembleMomentumFused(bool withB) {
+void FluidSolver::assembleMomentumFused(bool withB, bool withInv) {
   // One thread per cell assembles its row, its source and the relaxation in one pass over its
   // faces: no per-face coefficient arrays, no separate gather, divergence, cell and relaxation
   // kernels (~2.5x less memory traffic). Only valid where internal faces carry no explicit flux
@@ -816,7 +826,13 @@ void FluidSolver::assembleMomentumFused(bool withB) {
   k.withB = withB;
   k.gp = gradP_;
   k.b3 = b3_;
-  Kokkos::parallel_for("mfsi::fluid::momentum::assembleFused", RangePolicy(exec_, 0, nCells_), k);
+  // The relaxed diagonal is in a register here: its inverse costs a store, not invertDiagonal's
+  // pass over the matrix (64^3 cavity, 1 thread: ~1 ms per step).
+  if (withInv) k.inv = linear_.momentumInverseDiagonal(nCells_);
+  lid_t bad = nCells_;
+  Kokkos::parallel_reduce("mfsi::fluid::momentum::assembleFused", RangePolicy(exec_, 0, nCells_), k,
+                          Kokkos::Min<lid_t>(bad));
+  MFSI_CHECK(bad >= nCells_, "linear solver: diagonal entry of row " << bad << " is missing, zero or not finite");
 }
 
 void FluidSolver::computeHbyA(bool withRAU) {
@@ -1333,12 +1349,14 @@ StepResult FluidSolver::solve() {
     if (gradUCurrent_) computeVelocityGradient();
     // The fused assembly also forms the solve's right-hand side when the pressure gradient is
     // already current (the usual case: nothing changed it since the last corrector).
-    const bool bReady = assembleMomentum(/*withB=*/pim.momentumPredictor && gradPValid_);
+    const MomentumAssembly formed =
+        assembleMomentum(/*withB=*/pim.momentumPredictor && gradPValid_, /*withInv=*/pim.momentumPredictor);
+    const bool bReady = formed.b;
     updatePressureGradient();
     real momRes = 0;
     if (pim.momentumPredictor) {
       ScopedRegion r2("mfsi::fluid::momentum::solve");
-      linear_.momentumMatrixChanged(exec_, Au_);
+      linear_.momentumMatrixChanged(exec_, Au_, formed.inv ? InverseDiagonal::Given : InverseDiagonal::Compute);
       // The three components share the matrix: one solve reads it once for all of them, each
       // component stopping on its own scaled residual.
       if (!bReady) {

@@ -134,8 +134,13 @@ class FluidSolver {
   /// updatePressureGradient's boundary pressures and gradient in one pass over the cells (fused
   /// path, Gauss-linear stencil).
   void pressureGradientFused();
-  bool assembleMomentum(bool withB);
-  void assembleMomentumFused(bool withB);
+  /// What assembleMomentum formed besides the matrix and source (the fused path only).
+  struct MomentumAssembly {
+    bool b = false;    ///< the momentum solve's right-hand side (b3_)
+    bool inv = false;  ///< the Jacobi inverse diagonal (linear_.momentumInverseDiagonal)
+  };
+  MomentumAssembly assembleMomentum(bool withB, bool withInv);
+  void assembleMomentumFused(bool withB, bool withInv);
   void computeHbyA(bool withRAU);
   /// The phiHbyA face formula with this step's fields and coefficients (device functor).
   PhiHbyAFace phiHbyAFace() const;

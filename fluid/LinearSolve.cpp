@@ -57,13 +57,20 @@ LinearSolver::LinearSolver(lid_t n, PressurePreconditioner pp)
     pPrec_ = std::make_unique<JacobiPreconditioner>();
 }
 
-void LinearSolver::momentumMatrixChanged(const ExecSpace& exec, const CsrMatrix& A) {
-  if (uInvDiag_.extent(0) != static_cast<std::size_t>(A.nRows) || !uPrec_) {
-    uInvDiag_ =
-        RealView(Kokkos::view_alloc(Kokkos::WithoutInitializing, "mfsi::fluid::linear::momentumInvDiag"), A.nRows);
+RealView LinearSolver::momentumInverseDiagonal(lid_t n) {
+  if (uInvDiag_.extent(0) != static_cast<std::size_t>(n) || !uPrec_) {
+    uInvDiag_ = RealView(Kokkos::view_alloc(Kokkos::WithoutInitializing, "mfsi::fluid::linear::momentumInvDiag"), n);
     uPrec_ = std::make_unique<SharedJacobi>(uInvDiag_);
   }
-  invertDiagonal(exec, A, uInvDiag_);
+  return uInvDiag_;
+}
+
+void LinearSolver::momentumMatrixChanged(const ExecSpace& exec, const CsrMatrix& A, InverseDiagonal inverse) {
+  if (inverse == InverseDiagonal::Given)
+    MFSI_CHECK(uInvDiag_.extent(0) == static_cast<std::size_t>(A.nRows) && uPrec_,
+               "LinearSolver::momentumMatrixChanged: no inverse diagonal was given");
+  else
+    invertDiagonal(exec, A, momentumInverseDiagonal(A.nRows));
   uReady_ = true;
 }
 

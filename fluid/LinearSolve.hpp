@@ -22,6 +22,12 @@
 
 namespace mfsi::fluid {
 
+/// \brief How `LinearSolver::momentumMatrixChanged` gets the Jacobi inverse diagonal.
+enum class InverseDiagonal {
+  Compute,  ///< a pass over the matrix diagonal (invertDiagonal)
+  Given     ///< the caller wrote 1 / a_ii (0 where zero or not finite) into momentumInverseDiagonal()
+};
+
 /// \brief Result of one linear solve (scaled residuals, see the file comment).
 struct LinearSolveStats {
   int iterations = 0;
@@ -43,7 +49,11 @@ class LinearSolver {
   LinearSolver& operator=(LinearSolver&&) noexcept;
 
   /// \brief The momentum matrix got new values (same sparsity): refresh its preconditioner.
-  void momentumMatrixChanged(const ExecSpace& exec, const CsrMatrix& A);
+  void momentumMatrixChanged(const ExecSpace& exec, const CsrMatrix& A,
+                             InverseDiagonal inverse = InverseDiagonal::Compute);
+  /// \brief Storage of the momentum Jacobi's inverse diagonal (n entries), for a caller that
+  /// forms it while assembling (then `momentumMatrixChanged(..., InverseDiagonal::Given)`).
+  RealView momentumInverseDiagonal(lid_t n);
   /// \brief The pressure matrix got new values (same sparsity): refresh its preconditioner.
   void pressureMatrixChanged(const ExecSpace& exec, const CsrMatrix& A);
   /// \brief The pressure matrix values were (re)assembled: refresh the Krylov solver's own copy

@@ -35,9 +35,12 @@
 /// preconditioner far below what CG notices: the iteration counts are those of the double cycle.
 ///
 /// Measured (tests/kernels/test_amg.cpp, 7-point Dirichlet Poisson, rough right-hand side, CG to
-/// 1e-8): 7 / 8 / 8 iterations at 16^3, 24^3 and 32^3 with the default degree-3 Chebyshev
-/// smoother and lattice cubes (greedy aggregation: 7 / 7 / 8; degree 2: 9 / 9 / 9; Jacobi-CG:
-/// 59, 86, 116); operator complexity 1.5-1.6.
+/// 1e-8): 7 / 7 / 8 iterations at 16^3, 24^3 and 32^3 with the defaults (4th-kind Chebyshev of
+/// degree 2, prolongator damping 1.45, lattice cubes; Jacobi-CG: 59, 86, 116); operator
+/// complexity 1.5-1.6. perf/bench_linsolve, defaults, one thread: 8 / 8 / 9 iterations at
+/// 32^3 / 64^3 / 128^3, 0.69 / 7.6 / 62 ms per iteration (first-kind degree 3 before: 8 / 9 / 9,
+/// 0.84 / 7.9 / 74 ms). The figures below are from earlier defaults (first-kind Chebyshev of
+/// degree 3 or 2, damping 4/3).
 /// perf/bench_linsolve PressureSolve (same problem), greedy aggregation: 8 / 9 / 10 iterations at
 /// 32^3 / 64^3 / 128^3 in both precisions (degree 2: 9 / 10 / 12). Per CG iteration on one
 /// thread, float cycle vs double cycle: 64^3 11.5 vs 17.1 ms, 128^3 97 vs 133 ms
