@@ -199,33 +199,6 @@ inline double runRowDot(const double* v, const double* x, lid_t i, const lid_t* 
   return s;
 }
 
-/// `reduce` over a matrix's runs: per block of kRowBlock rows, runBody(r) for the block's runs in
-/// order (writing per-row results), then rowSum(i, sums) for its rows in order.
-template <int N, class RunBody, class RowSum>
-std::array<double, N> reduceRuns(const ExecSpace& exec, const SolverComm& comm, const std::string& label,
-                                 const CsrMatrix& A, const RunBody& runBody, const RowSum& rowSum) {
-  const lid_t n = A.nRows, bs = kRowBlock;
-  const lid_t nBlocks = (n + bs - 1) / bs;
-  std::vector<double> partial(static_cast<std::size_t>(nBlocks) * N);
-  double* part = partial.data();
-  const lid_t* blockStart = A.runs.blockStart.data();
-  exec.fence();
-  Kokkos::parallel_for(label, hostPolicy(exec, 0, nBlocks), [=](lid_t blk) {
-    for (lid_t r = blockStart[blk]; r < blockStart[blk + 1]; ++r) runBody(r);
-    Sums<N> s;
-    for (int k = 0; k < N; ++k) s[k] = 0.0;
-    const lid_t end = (blk + 1) * bs < n ? (blk + 1) * bs : n;
-    for (lid_t i = blk * bs; i < end; ++i) rowSum(i, s);
-    for (int k = 0; k < N; ++k) part[static_cast<std::size_t>(blk) * N + k] = s[k];
-  });
-  HostExecSpace().fence();
-  std::array<double, N> out{};
-  for (lid_t b = 0; b < nBlocks; ++b)
-    for (int k = 0; k < N; ++k) out[k] += part[static_cast<std::size_t>(b) * N + k];
-  comm.globalSum(out.data(), N);
-  return out;
-}
-
 /// Host `reduceLanes` with a per-block pass first: per block [b0, b1) of kRowBlock rows,
 /// blockBody(b0, b1) (e.g. a vectorised sweep writing per-row results), then rowSum(i, sums) for
 /// its rows in `reduceLanes`' lane order: the same sums as `reduceLanes` of the fused row body.
@@ -257,6 +230,22 @@ std::array<double, N> reduceHostLanes(const ExecSpace& exec, const SolverComm& c
     for (int k = 0; k < N; ++k) out[k] += part[static_cast<std::size_t>(b) * N + k];
   comm.globalSum(out.data(), N);
   return out;
+}
+
+/// `reduce` over a matrix's runs: per block of kRowBlock rows, runBody(r) for the block's runs in
+/// order (writing per-row results), then rowSum(i, sums) for its rows in order (`reduceHostLanes`
+/// with one lane; runs never cross a block boundary, see CsrRowRuns).
+template <int N, class RunBody, class RowSum>
+std::array<double, N> reduceRuns(const ExecSpace& exec, const SolverComm& comm, const std::string& label,
+                                 const CsrMatrix& A, const RunBody& runBody, const RowSum& rowSum) {
+  const lid_t* blockStart = A.runs.blockStart.data();
+  return reduceHostLanes<N, 1>(
+      exec, comm, label, A.nRows,
+      [=](lid_t b0, lid_t) {
+        const lid_t blk = b0 / kRowBlock;
+        for (lid_t r = blockStart[blk]; r < blockStart[blk + 1]; ++r) runBody(r);
+      },
+      rowSum);
 }
 
 /// Whether A's kernels take the run path.

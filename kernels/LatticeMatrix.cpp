@@ -196,7 +196,7 @@ double SymmetricLatticeMatrix::spmvDot(const ExecSpace& exec, const SolverComm& 
         [=](lid_t i0, lid_t i1) { latticeRowsHost(P, i0, i1, xp, yp); },
         [=](lid_t i, blas::Sums<1>& s) { s[0] += wp[i] * yp[i]; })[0];
   } else {
-    const double *d = diag_.data(), *ux = ux_.data(), *uy = uy_.data(), *uz = uz_.data();
+    const double *d = P.d, *ux = P.ux, *uy = P.uy, *uz = P.uz;
     const double* xp = x.data();
     const RealView yv = y;
     const ConstRealView wv = w;
