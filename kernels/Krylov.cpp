@@ -124,23 +124,27 @@ RealView workResidual(const InitialResidual* r0, RealView& own, lid_t n, const c
 }
 
 /// Row i of A M^{-1} X for the three columns of X, M = diag(1 / inv): the Jacobi scaling is formed
-/// inside the gather, so A and inv are read once for all columns (BiCGStab3's two products).
+/// inside the gather, so A and inv are read once for all columns (BiCGStab3's two products). Each
+/// term is (a_ij inv_j) x_jc: one product of the scaled coefficient serves the three columns.
 KOKKOS_INLINE_FUNCTION void jacobiRow3(const ConstIndexView& rowPtr, const ConstIndexView& colIdx,
                                        const ConstRealView& val, const ConstRealView& inv, const Real3View& x,
                                        lid_t i, double out[3]) {
   out[0] = out[1] = out[2] = 0.0;
   for (lid_t k = rowPtr(i); k < rowPtr(i + 1); ++k) {
-    const double a = val(k);
     const lid_t j = colIdx(k);
-    const double d = inv(j);
-    out[0] += a * (d * x(j, 0));
-    out[1] += a * (d * x(j, 1));
-    out[2] += a * (d * x(j, 2));
+    const double a = val(k) * inv(j);
+    out[0] += a * x(j, 0);
+    out[1] += a * x(j, 1);
+    out[2] += a * x(j, 2);
   }
 }
 
 /// jacobiRow3 for the rows of run `run` (host backends, see blas::detail::forRunRows): y = A (inv .* x)
-/// for the three columns of the row-major n x 3 arrays x and y, each sum in jacobiRow3's order.
+/// for the columns c of the row-major n x 3 arrays x and y whose bit (1 << c) is set in Mask, each
+/// sum in jacobiRow3's order; the other columns of y are not written. Once a column has converged
+/// (cavity 64^3: the second iteration's products are for one or two columns) the products skip
+/// its gathers and arithmetic.
+template <int Mask>
 inline void jacobiRun3(const blas::detail::RunView& R, lid_t run, const double* inv, const double* x, double* y) {
   static_assert(!kHostExec || std::is_same<Real3View::array_layout, Kokkos::LayoutRight>::value,
                 "host n x 3 views are row-major");
@@ -148,15 +152,24 @@ inline void jacobiRun3(const blas::detail::RunView& R, lid_t run, const double* 
     double s0 = 0.0, s1 = 0.0, s2 = 0.0;
     for (int k = 0; k < width; ++k) {
       const lid_t j = i + off[k];
-      const double a = v[k], d = inv[j];
-      s0 += a * (d * x[3 * j]);
-      s1 += a * (d * x[3 * j + 1]);
-      s2 += a * (d * x[3 * j + 2]);
+      const double a = v[k] * inv[j];
+      if constexpr ((Mask & 1) != 0) s0 += a * x[3 * j];
+      if constexpr ((Mask & 2) != 0) s1 += a * x[3 * j + 1];
+      if constexpr ((Mask & 4) != 0) s2 += a * x[3 * j + 2];
     }
-    y[3 * i] = s0;
-    y[3 * i + 1] = s1;
-    y[3 * i + 2] = s2;
+    if constexpr ((Mask & 1) != 0) y[3 * i] = s0;
+    if constexpr ((Mask & 2) != 0) y[3 * i + 1] = s1;
+    if constexpr ((Mask & 4) != 0) y[3 * i + 2] = s2;
   });
+}
+
+/// jacobiRun3 for the columns set in `mask` (1..7).
+inline void jacobiRun3(int mask, const blas::detail::RunView& R, lid_t run, const double* inv, const double* x,
+                       double* y) {
+  using Run = void (*)(const blas::detail::RunView&, lid_t, const double*, const double*, double*);
+  static constexpr Run kByMask[8] = {nullptr,       jacobiRun3<1>, jacobiRun3<2>, jacobiRun3<3>,
+                                     jacobiRun3<4>, jacobiRun3<5>, jacobiRun3<6>, jacobiRun3<7>};
+  kByMask[mask](R, run, inv, x, y);
 }
 
 }  // namespace
@@ -386,9 +399,10 @@ KrylovResult BiCGStab::run(const ExecSpace& exec, const CsrMatrix& A, const Cons
 // Three-column BiCGStab (see the class comment). Every column c runs exactly the recurrence of
 // BiCGStab::run with M = diag(A)^{-1}; the kernels loop over the columns still active and skip
 // the others. The preconditioned vectors phat = inv .* p and shat = inv .* s are never stored:
-// each use forms the same product inv_j * p_j on the fly (inside the SpMV gathers and the x
-// update), which saves writing and re-reading two n x 3 vectors per iteration for one read of
-// inv, and gives bitwise the values a stored phat / shat would have. Per iteration (all columns
+// the x update forms inv_i * p_i on the fly (bitwise a stored phat's value) and the SpMV gathers
+// scale the coefficient instead, (a_ij * inv_j) * p_j, one product for the three columns (a
+// stored phat would give a_ij * (inv_j * p_j): equal to round-off). This saves writing and
+// re-reading two n x 3 vectors per iteration for one read of inv. Per iteration (all columns
 // together) one direction kernel and four fused reductions:
 //   K1  p = r + beta (p - omega v)                            (iteration 1: p = r, rhat = r)
 //   K2  v = A (inv .* p);          sums {rhat.v}              -> alpha
@@ -529,12 +543,13 @@ std::array<KrylovResult, 3> BiCGStab3::run(const ExecSpace& exec, const CsrMatri
         });
 
     // K2: v = A phat with phat_j = inv_j p_j formed in the gather (A and inv read once for the
-    // three columns), and rhat.v.
+    // three columns; the run path forms the active columns only), and rhat.v.
     comm_.updateGhosts(exec, p);
+    const int vMask = (active[0] ? 1 : 0) | (active[1] ? 2 : 0) | (active[2] ? 4 : 0);
     const auto rv = blas::detail::useRuns(A)
         ? blas::detail::reduceRuns<3>(
               exec, comm_, "mfsi::kernels::krylov::bicgstab3::v", A,
-              [=](lid_t run) { jacobiRun3(R, run, invp, p.data(), v.data()); },
+              [=](lid_t run) { jacobiRun3(vMask, R, run, invp, p.data(), v.data()); },
               [=](lid_t i, Sums<3>& acc) {
                 for (int c = 0; c < 3; ++c) acc[c] += rhat(i, c) * v(i, c);
               })
@@ -600,10 +615,11 @@ std::array<KrylovResult, 3> BiCGStab3::run(const ExecSpace& exec, const CsrMatri
     for (int c = 0; c < 3; ++c) w[c] = 0.0;
     if (anyFull) {
       comm_.updateGhosts(exec, r);
+      const int tMask = (mode[0] == FullStep ? 1 : 0) | (mode[1] == FullStep ? 2 : 0) | (mode[2] == FullStep ? 4 : 0);
       const auto ts = blas::detail::useRuns(A)
           ? blas::detail::reduceRuns<6>(
                 exec, comm_, "mfsi::kernels::krylov::bicgstab3::t", A,
-                [=](lid_t run) { jacobiRun3(R, run, invp, r.data(), t.data()); },
+                [=](lid_t run) { jacobiRun3(tMask, R, run, invp, r.data(), t.data()); },
                 [=](lid_t i, Sums<6>& acc) {
                   for (int c = 0; c < 3; ++c) {
                     acc[c] += t(i, c) * r(i, c);

@@ -178,13 +178,15 @@ struct InitialResidual3 {
 /// Design rationale: the three systems share A and the preconditioner but nothing else, so they
 /// are three independent BiCGStab recurrences - each column has its own scalars, stopping test,
 /// iteration count and status, and gives the iterates of a separate `BiCGStab` + Jacobi solve of
-/// that column (the same operations in the same order; tested to round-off). What is shared is
+/// that column (the same recurrence; the products form (a_ij d_j) x_j where the separate solve
+/// forms a_ij (d_j x_j), so they agree to round-off, as tested). What is shared is
 /// the memory traffic: the columns are advanced in lockstep on n x 3 multi-vectors (the layout of
 /// the fluid's U), so each SpMV reads A once for all three, each iteration's reductions of the
 /// three columns are one `blas::reduce` (4 global reductions per iteration, not 12), and the
 /// Jacobi scaling is applied inside the SpMV gathers and the x update instead of in separate
 /// passes (the preconditioned vectors are never stored). A column that has converged (or broken
-/// down) is frozen: x and r of that column are no longer touched while the others iterate.
+/// down) is frozen: x and r of that column are no longer touched while the others iterate, and
+/// on host backends the products skip its gathers.
 /// Jacobi is built in (not a `Preconditioner&`) because fusing it needs the inverse diagonal
 /// inside the kernels; a multigrid preconditioner would not fuse anyway.
 class BiCGStab3 {
