@@ -187,6 +187,11 @@ Schema fluidSchema() {
       .key("finalRelTol",
            Schema::real("relTol of the last pressure solve of a step (pFinal; < 0: relTol)", "-").lessThan(1),
            Default(d.pressureFinalRelTol))
+      .key("finestSweeps",
+           Schema::integer("AMG smoother applications on the finest level in the pressure solves before the final one "
+                           "of a step (the final one uses 1)")
+               .atLeast(1),
+           Default(d.pressureFinestSweeps))
       .key("preconditioner", Schema::choice("conjugate-gradient preconditioner", {"amg", "jacobi"}), Default("amg"))
       .key("preconditionerRefresh",
            Schema::integer("most outer iterations between AMG value refreshes (earlier when the final pressure solve "
@@ -284,6 +289,7 @@ FluidOptions readFluidOptions(const SceneConfig& c, const HexMesh& mesh) {
   o.pressureSolver = solver("solvers.pressure");
   o.momentumSolver = solver("solvers.momentum");
   o.pressureFinalRelTol = c.get<double>("solvers.pressure.finalRelTol");
+  o.pressureFinestSweeps = c.get<int>("solvers.pressure.finestSweeps");
   o.pressurePreconditioner = c.get<std::string>("solvers.pressure.preconditioner") == "jacobi"
                                  ? PressurePreconditioner::Jacobi
                                  : PressurePreconditioner::Amg;

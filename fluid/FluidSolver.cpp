@@ -1404,6 +1404,7 @@ StepResult FluidSolver::solve() {
         const bool finalSolve =
             outer == pim.nOuterCorrectors - 1 && corr == pim.nCorrectors - 1 && no == pim.nNonOrthogonalCorrectors;
         if (finalSolve && opt_.pressureFinalRelTol >= 0) ps.relTol = opt_.pressureFinalRelTol;
+        ps.amgFinestSweeps = finalSolve ? 1 : opt_.pressureFinestSweeps;
         // The final solve starts from p plus the change the last final solve made: from one step
         // to the next the correctors change p by similar amounts (cavity 64^3: 7x smaller
         // initial residual, one iteration fewer).

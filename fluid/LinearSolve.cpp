@@ -94,6 +94,7 @@ LinearSolveStats LinearSolver::solveMomentum(const ExecSpace& exec, const CsrMat
 
 LinearSolveStats LinearSolver::solvePressure(const ExecSpace& exec, const CsrMatrix& A, const ConstRealView& b,
                                              const RealView& x, const LinearSolverOptions& o) {
+  if (auto* amg = dynamic_cast<AmgPreconditioner*>(pPrec_.get())) amg->setFinestSweeps(o.amgFinestSweeps);
   return solve(exec, *pSolver_, *pPrec_, A, b, x, o);
 }
 

@@ -961,7 +961,7 @@ struct detail::AmgHierarchy {
 };
 
 AmgPreconditioner::AmgPreconditioner(const AmgOptions& options) : options_(options) {
-  MFSI_CHECK(options.sweeps >= 1, "amg: sweeps must be >= 1");
+  MFSI_CHECK(options.sweeps >= 1 && options.finestSweeps >= 0, "amg: sweeps must be >= 1 and finestSweeps >= 0");
   MFSI_CHECK(options.chebyshevDegree >= 1, "amg: chebyshevDegree must be >= 1");
   MFSI_CHECK(options.chebyshevRatio > 1.0, "amg: chebyshevRatio must be > 1");
   MFSI_CHECK(options.strengthThreshold >= 0.0 && options.strengthThreshold < 1.0,
@@ -1017,13 +1017,18 @@ std::vector<Step> smootherSteps(double lambdaMax, const AmgOptions& opt, int swe
   return steps;
 }
 
-/// Diagonal inverse, lambda_max(D^{-1} A) and smoother coefficients of a level (values only).
-void levelSmootherData(const ExecSpace& exec, Level& L, const AmgOptions& opt) {
+/// Smoother applications on level l.
+int levelSweeps(const AmgOptions& opt, std::size_t l) {
+  return l == 0 && opt.finestSweeps > 0 ? opt.finestSweeps : opt.sweeps;
+}
+
+/// Diagonal inverse, lambda_max(D^{-1} A) and smoother coefficients of level l (values only).
+void levelSmootherData(const ExecSpace& exec, Level& L, std::size_t l, const AmgOptions& opt) {
   invertDiagonal(exec, L.A, L.invDiag);
   L.lambdaMax = estimateLambdaMax(exec, L.A, L.invDiag, opt.eigenSteps);
   MFSI_CHECK(L.lambdaMax > 0.0 && std::isfinite(L.lambdaMax),
              "amg: could not estimate the spectral radius (rows " << L.A.nRows << ", estimate " << L.lambdaMax << ")");
-  L.steps = smootherSteps(L.lambdaMax, opt, opt.sweeps);
+  L.steps = smootherSteps(L.lambdaMax, opt, levelSweeps(opt, l));
   L.coarseSteps = smootherSteps(L.lambdaMax, opt, kCoarseSweeps);
 }
 
@@ -1168,7 +1173,7 @@ void AmgPreconditioner::setup(const ExecSpace& exec, const CsrMatrix& A) {
   lv[0].A = A;
   for (std::size_t l = 0;; ++l) {
     lv[l].invDiag = RealView("mfsi::kernels::amg::level" + std::to_string(l) + "::invDiag", lv[l].A.nRows);
-    levelSmootherData(exec, lv[l], options_);
+    levelSmootherData(exec, lv[l], l, options_);
     const lid_t n = lv[l].A.nRows;
     if (n <= options_.coarseSize || static_cast<int>(l) + 1 >= options_.maxLevels) break;
 
@@ -1235,7 +1240,7 @@ void AmgPreconditioner::updateValues(const ExecSpace& exec, const CsrMatrix& A) 
   auto& lv = h_->levels;
   lv[0].A = A;
   for (std::size_t l = 0; l < lv.size(); ++l) {
-    levelSmootherData(exec, lv[l], options_);
+    levelSmootherData(exec, lv[l], l, options_);
     if (l + 1 < lv.size()) levelTransferValues(exec, lv[l], lv[l + 1], options_);
   }
   coarsestInverse(exec, *h_, options_.maxDirectSize);
@@ -1248,7 +1253,7 @@ void AmgPreconditioner::updateFinestSmoother(const ExecSpace& exec, const CsrMat
   ScopedRegion region("mfsi::kernels::amg::updateFinestSmoother");
   auto& L = h_->levels[0];
   L.A = A;
-  levelSmootherData(exec, L, options_);
+  levelSmootherData(exec, L, 0, options_);
   if (options_.precision == AmgPrecision::Double)
     syncCycleValues(exec, *h_, h_->cycleDouble[0], 0, true);
   else
@@ -1373,6 +1378,15 @@ void applyCycle(const ExecSpace& exec, const detail::AmgHierarchy& h,
 }
 
 }  // namespace
+
+void AmgPreconditioner::setFinestSweeps(int sweeps) {
+  MFSI_CHECK(sweeps >= 0, "amg: finestSweeps must be >= 0 (0: sweeps)");
+  options_.finestSweeps = sweeps;
+  if (h_ != nullptr) {
+    auto& L = h_->levels[0];
+    L.steps = smootherSteps(L.lambdaMax, options_, levelSweeps(options_, 0));
+  }
+}
 
 void AmgPreconditioner::apply(const ExecSpace& exec, const ConstRealView& r, const RealView& z) {
   MFSI_CHECK(h_ != nullptr, "amg: apply() before setup()");

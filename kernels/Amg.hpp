@@ -101,6 +101,9 @@ struct AmgOptions {
   AmgProlongation prolongation = AmgProlongation::Smoothed;
   AmgSmoother smoother = AmgSmoother::ChebyshevFourthKind;
   int sweeps = 1;           ///< smoother applications before and after the coarse correction
+  /// Smoother applications on the finest level (0: `sweeps`); `setFinestSweeps` changes it
+  /// between solves without a new set-up.
+  int finestSweeps = 0;
   /// Polynomial degree (SpMVs per smoother application). 4th kind, measured on the 3D cavity at
   /// 64^3 (perf/bench_cavity3d, AMG-CG iterations per step): degree 1 / 2 / 3 / 4: 11.7 / 7.40 /
   /// 7.40 / 7.33; degree 2 needs the fewest sweeps per step. First kind (ratio 10, the default
@@ -181,6 +184,10 @@ class AmgPreconditioner final : public Preconditioner {
   /// preconditioner for SPD A, and degrades slowly as the values drift from the last full update.
   /// For values that change a little every step (mesh motion): full update every k steps.
   void updateFinestSmoother(const ExecSpace& exec, const CsrMatrix& A);
+  /// \brief Smoother applications on the finest level from now on (0: `sweeps`): a host-side
+  /// change of the level's step coefficients, no set-up. A loose solve that a stronger cycle
+  /// finishes one iteration sooner can ask for more than the tight solves that follow it.
+  void setFinestSweeps(int sweeps);
   /// \brief z = one V-cycle applied to r, from a zero initial guess.
   void apply(const ExecSpace& exec, const ConstRealView& r, const RealView& z) override;
   std::string name() const override { return "amg"; }

@@ -204,6 +204,36 @@ TEST(Amg, OptionsChangeTheCycle) {
   EXPECT_LT(itTwo, sa);
 }
 
+TEST(Amg, FinestSweepsChangeBetweenSolvesWithoutASetUp) {
+  // setFinestSweeps(2) smooths the finest level twice: fewer iterations than once; back to 0 the
+  // cycle is the set-up's again (bitwise the same iterates). Two finest sweeps from the options
+  // at set-up give the same cycle as switching to them afterwards.
+  mfsi::ExecSpace exec;
+  const auto A = mfsi::buildPoisson7({20, 20, 20}, mfsi::ModelBoundary::Dirichlet);
+  const auto b = roughRhs(A.nRows, false);
+  mfsi::AmgPreconditioner amg;
+  amg.setup(exec, A);
+  mfsi::RealView x1, x2, x1again, x2fresh;
+  const auto once = solveCg(A, b, amg, x1);
+  amg.setFinestSweeps(2);
+  const auto twice = solveCg(A, b, amg, x2);
+  amg.setFinestSweeps(0);
+  const auto again = solveCg(A, b, amg, x1again);
+  mfsi::AmgOptions o;
+  o.finestSweeps = 2;
+  mfsi::AmgPreconditioner fresh(o);
+  fresh.setup(exec, A);
+  const auto fromSetup = solveCg(A, b, fresh, x2fresh);
+  std::cout << "[ amg      ] 20^3: finest sweeps 1 / 2: " << once.iterations << " / " << twice.iterations << " its\n";
+  EXPECT_TRUE(once.converged && twice.converged);
+  EXPECT_LT(twice.iterations, once.iterations);
+  EXPECT_EQ(again.iterations, once.iterations);
+  EXPECT_EQ(host(x1again), host(x1));
+  EXPECT_EQ(fromSetup.iterations, twice.iterations);
+  EXPECT_EQ(host(x2fresh), host(x2));
+  EXPECT_THROW(amg.setFinestSweeps(-1), std::exception);
+}
+
 TEST(Amg, SingularNeumannSystemConverges) {
   mfsi::ExecSpace exec;
   const auto A = mfsi::buildPoisson7({20, 18, 16}, mfsi::ModelBoundary::Neumann);
