@@ -5,6 +5,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <utility>
 
 namespace mfsi::fluid {
 
@@ -407,7 +408,9 @@ void FluidSolver::beginStep(real t, real dt) {
   const bool ac = compressible();
   if (nSteps_ > 0) {
     dt0_ = dt_;
-    if (bdf2 || extrapolatesVelocity()) Kokkos::deep_copy(exec_, U00_, U0_);
+    // U00 <- U0 by handing the arrays on (U0_ is rewritten in full just below): one n x 3 copy
+    // per step fewer. Kernels take these handles at launch, so none holds the old ones.
+    if (bdf2 || extrapolatesVelocity()) std::swap(U00_, U0_);
     if (bdf2) Kokkos::deep_copy(exec_, V00_, V0_);
     if (ac) Kokkos::deep_copy(exec_, p00_, p0_);
     if (!(sweptNewZero_ && sweptOldZero_)) Kokkos::deep_copy(exec_, sweptOld_, sweptNew_);
