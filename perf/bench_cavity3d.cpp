@@ -19,7 +19,9 @@
 //  - pressure: CG + smoothed-aggregation AMG, scaled residual 1e-6, relTol 0.05 on the first
 //    corrector and 0 on the final one (pFinal), as icoFoam's GAMG settings. The AMG values are
 //    refreshed at most every 50 pressure assemblies, earlier when the final solve slows down (a
-//    stale hierarchy is still an SPD preconditioner); the V-cycle runs in float.
+//    stale hierarchy is still an SPD preconditioner); the V-cycle runs in float, with two
+//    finest-level smoother applications in the first corrector's solve (the fluid's default,
+//    solvers.pressure.finestSweeps).
 //
 // Second argument 1 = profile: Kokkos Tools region callbacks accumulate inclusive wall time per
 // solver phase (fluid::momentum::assemble, ...::solve, fluid::pressure::assemble, ...::solve,

@@ -14,7 +14,8 @@
 #    Timed between the time-stamped ExecutionTime lines of step 5 and of the last step.
 #  - Ours (perf/bench_cavity3d.cpp): PISO with momentum predictor and 2 correctors, Euler, central
 #    convection; p: CG + smoothed-aggregation AMG, abs 1e-6 (OpenFOAM's scaled residual), relTol 0.05
-#    on the first corrector and 0 on the final one (as icoFoam's p/pFinal); U: the three components
+#    on the first corrector and 0 on the final one (as icoFoam's p/pFinal; the first with two
+#    finest-level smoother applications per V-cycle, solvers.pressure.finestSweeps); U: the three components
 #    in one BiCGStab3 + Jacobi, abs 1e-5; all solves stop on OpenFOAM's scaled 1-norm residual.
 #    Initial guesses (pimple.extrapolateGuess, on by default): U extrapolated in time for the
 #    momentum solve, the final pressure solve from the last step's final-corrector change (icoFoam
@@ -180,7 +181,7 @@ doc = {"what": "3D lid-driven cube cavity Re=100, ours (bench_cavity3d) vs OpenF
        "reproduce": "MFSI_BUILD=<build dir> perf/compare_openfoam.sh %d %d %d" % (n, steps, repeats),
        "openfoam_settings": foamtools.case_settings(os.environ["CASE"]),
        "ours_settings": "PISO: 1 outer, momentum predictor, 2 pressure correctors, 0 non-orth.; Euler; central "
-                        "(Gauss linear) convection, Green-Gauss gradients; p: CG + SA-AMG (float V-cycle; values refreshed at most every 50 steps, earlier when stale), "
+                        "(Gauss linear) convection, Green-Gauss gradients; p: CG + SA-AMG (float V-cycle, 2 finest-level smoother applications in the relTol 0.05 solve; values refreshed at most every 50 steps, earlier when stale), "
                         "scaled residual 1e-6, relTol 0.05 then 0 (pFinal); U: BiCGStab3 (3 components) + Jacobi 1e-5, relTol 0; stop on the scaled 1-norm; "
                         "extrapolated initial guesses (U in time; final p from the last step's final-corrector change); "
                         "OMP_PROC_BIND=spread OMP_PLACES=cores",
