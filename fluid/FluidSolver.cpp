@@ -938,8 +938,67 @@ void FluidSolver::pinPressureLevel() {
   const lid_t ref = opt_.pressureReferenceCell;
   ConstIndexView di = Ap_.diagIdx;
   auto vals = Ap_.values;
+  RealView d = pressureLattice_ != nullptr ? pressureLattice_->diagonal() : RealView();
   Kokkos::parallel_for(
-      "mfsi::fluid::pressure::reference", RangePolicy(exec_, 0, 1), KOKKOS_LAMBDA(lid_t) { vals(di(ref)) *= 2.0; });
+      "mfsi::fluid::pressure::reference", RangePolicy(exec_, 0, 1), KOKKOS_LAMBDA(lid_t) {
+        if (d.extent(0) > 0)
+          d(ref) *= 2.0;
+        else
+          vals(di(ref)) *= 2.0;
+      });
+}
+
+/// One row of the fused pressure matrix: the diagonal and the source's divergence of the face
+/// fluxes of a cell, in one walk over its faces, calling coupling(e, n, -coef) for each internal
+/// face (cell-face entry e, neighbour n). Shared by the CSR and lattice assemblies.
+struct PressureRow {
+  lid_t nIn = 0;
+  bool comp = false, stored = false;
+  real k = 0, c1 = 0;
+  ConstIndexView off, cf, own, nei, kind;
+  ConstRealView w, dc, rAU, V, flux, cp;
+
+  template <class Coupling>
+  KOKKOS_FORCEINLINE_FUNCTION void operator()(lid_t cell, real& diag, real& div, const Coupling& coupling) const {
+    diag = comp ? k * c1 * V(cell) : 0.0;
+    div = 0.0;
+    for (lid_t e = off(cell); e < off(cell + 1); ++e) {
+      const lid_t f = cf(e);
+      const lid_t o = own(f);
+      div += (o == cell ? 1.0 : -1.0) * flux(f);
+      if (f < nIn) {
+        const real coef = stored ? cp(f) : pressureFaceCoefficient(f, o, nei(f), w, rAU, dc);
+        diag += coef;
+        coupling(e, o == cell ? nei(f) : o, -coef);
+      } else if (stored) {
+        diag += cp(f);
+      } else {
+        diag += kind(f - nIn) == kFacePressure ? rAU(cell) * dc(f) : 0.0;
+      }
+    }
+  }
+};
+
+PressureRow FluidSolver::pressureRow(bool stored) const {
+  PressureRow row;
+  row.nIn = nIn_;
+  row.comp = compressible();
+  row.stored = stored;
+  const real c = opt_.artificialCompressibility.soundSpeed;
+  row.k = row.comp ? 1.0 / (opt_.density * c * c * dt_) : 0.0;
+  row.c1 = c1_;
+  row.off = mesh_.cellFaceOffsets();
+  row.cf = mesh_.cellFaces();
+  row.own = mesh_.faceOwner();
+  row.nei = mesh_.faceNeighbour();
+  row.kind = bc_.kind();
+  row.w = fd_.weight;
+  row.dc = fd_.deltaCoeff;
+  row.rAU = rAU_;
+  row.V = geo_.cellVolume;
+  row.flux = fluxP_;
+  row.cp = coefP_;
+  return row;
 }
 
 void FluidSolver::assemblePressureMatrixFused(bool stored) {
@@ -950,36 +1009,45 @@ void FluidSolver::assemblePressureMatrixFused(bool stored) {
   // the walk over the cell's faces. With `stored` the face coefficients are read from coefP_
   // (written by the source-flux pass, which has the interpolated rAU at hand) instead of formed
   // from four face and two cell values: the same numbers.
-  const lid_t nIn = nIn_;
-  const bool comp = compressible();
-  const real c = opt_.artificialCompressibility.soundSpeed;
-  const real k = comp ? 1.0 / (opt_.density * c * c * dt_) : 0.0, c1 = c1_;
-  ConstIndexView off = mesh_.cellFaceOffsets(), cf = mesh_.cellFaces(), own = mesh_.faceOwner(),
-                 nei = mesh_.faceNeighbour();
-  ConstIndexView cfp = sparsity_.cellFacePos, rowPtr = Ap_.rowPtr, di = Ap_.diagIdx, kind = bc_.kind();
-  ConstRealView w = fd_.weight, dc = fd_.deltaCoeff, rAU = rAU_, V = geo_.cellVolume, flux = fluxP_, cp = coefP_;
+  const PressureRow row = pressureRow(stored);
+  ConstIndexView cfp = sparsity_.cellFacePos, rowPtr = Ap_.rowPtr, di = Ap_.diagIdx;
   auto vals = Ap_.values;
   auto rhs = rhsP_;
   Kokkos::parallel_for(
       "mfsi::fluid::pressure::assembleFused", RangePolicy(exec_, 0, nCells_), KOKKOS_LAMBDA(lid_t cell) {
         for (lid_t e = rowPtr(cell); e < rowPtr(cell + 1); ++e) vals(e) = 0.0;
-        real diag = comp ? k * c1 * V(cell) : 0.0;
-        real div = 0.0;
-        for (lid_t e = off(cell); e < off(cell + 1); ++e) {
-          const lid_t f = cf(e);
-          const lid_t o = own(f);
-          div += (o == cell ? 1.0 : -1.0) * flux(f);
-          if (f < nIn) {
-            const real coef = stored ? cp(f) : pressureFaceCoefficient(f, o, nei(f), w, rAU, dc);
-            diag += coef;
-            vals(cfp(e)) += -coef;
-          } else if (stored) {
-            diag += cp(f);
-          } else {
-            diag += kind(f - nIn) == kFacePressure ? rAU(cell) * dc(f) : 0.0;
-          }
-        }
+        real diag, div;
+        row(cell, diag, div, [&](lid_t e, lid_t, real a) { vals(cfp(e)) += a; });
         vals(di(cell)) += diag;
+        rhs(cell) = -1.0 * div;
+      });
+}
+
+void FluidSolver::assemblePressureLatticeFused(SymmetricLatticeMatrix& lattice, bool stored) {
+  // assemblePressureMatrixFused's row, written to the lattice: the diagonal (the same sum in the
+  // same order) and the couplings to the +x, +y, +z neighbours (0 where the lattice ends). The
+  // lower couplings are the neighbours' upper ones: the one coefficient of a face serves both
+  // rows (symmetric by construction).
+  const PressureRow row = pressureRow(stored);
+  const lid_t sy = lattice.nx(), sz = lattice.nx() * lattice.ny();
+  const bool hasZ = lattice.nz() > 1;
+  const RealView d = lattice.diagonal(), ux = lattice.upperX(), uy = lattice.upperY(), uz = lattice.upperZ();
+  auto rhs = rhsP_;
+  Kokkos::parallel_for(
+      "mfsi::fluid::pressure::assembleLattice", RangePolicy(exec_, 0, nCells_), KOKKOS_LAMBDA(lid_t cell) {
+        real diag, div, cx = 0.0, cy = 0.0, cz = 0.0;
+        row(cell, diag, div, [&](lid_t, lid_t n, real a) {
+          if (n == cell + 1)
+            cx = a;
+          else if (n == cell + sy)
+            cy = a;
+          else if (n == cell + sz)
+            cz = a;
+        });
+        d(cell) = diag;
+        ux(cell) = cx;
+        uy(cell) = cy;
+        if (hasZ) uz(cell) = cz;
         rhs(cell) = -1.0 * div;
       });
 }
@@ -1069,12 +1137,21 @@ void FluidSolver::assemblePressure(bool matrix) {
   else
     pressureSourceFluxFaces();
   if (fusedMatrix) {
-    assemblePressureMatrixFused(/*stored=*/fusedPressureSource());
+    // CG's lattice takes the values directly when the sparsity is a lattice (no CSR values, no
+    // copy pass: 64^3 cavity ~2 ms per step); lines of one cell (nx or ny = 1) keep CSR.
+    SymmetricLatticeMatrix* lattice = linear_.pressureLattice(Ap_);
+    pressureLattice_ = lattice != nullptr && lattice->nx() > 1 && lattice->ny() > 1 ? lattice : nullptr;
+    if (pressureLattice_ != nullptr)
+      assemblePressureLatticeFused(*pressureLattice_, /*stored=*/fusedPressureSource());
+    else
+      assemblePressureMatrixFused(/*stored=*/fusedPressureSource());
   } else {
+    if (matrix) pressureLattice_ = nullptr;
     if (matrix) assemblePressureMatrixFaces();
     divergence<1>(exec_, mesh_, fluxP_, rhsP_, opt_.reduction, /*accumulate=*/false, /*sign=*/-1.0);
   }
   if (matrix && pinsPressureLevel()) pinPressureLevel();
+  if (matrix && pressureLattice_ != nullptr) linear_.pressureLatticeAssembled(Ap_);
   finishPressureSource();
 }
 
@@ -1126,10 +1203,12 @@ void FluidSolver::finishPressureSource() {
     const real pRef = opt_.pressureReferenceValue;
     ConstIndexView di = Ap_.diagIdx;
     ConstRealView vals = Ap_.values;
+    ConstRealView d = pressureLattice_ != nullptr ? pressureLattice_->diagonal() : RealView();
     auto rhs = rhsP_;
     Kokkos::parallel_for(
-        "mfsi::fluid::pressure::referenceSource", RangePolicy(exec_, 0, 1),
-        KOKKOS_LAMBDA(lid_t) { rhs(ref) += 0.5 * vals(di(ref)) * pRef; });
+        "mfsi::fluid::pressure::referenceSource", RangePolicy(exec_, 0, 1), KOKKOS_LAMBDA(lid_t) {
+          rhs(ref) += 0.5 * (d.extent(0) > 0 ? d(ref) : vals(di(ref))) * pRef;
+        });
   }
 }
 
@@ -1390,7 +1469,7 @@ StepResult FluidSolver::solve() {
       for (int no = 0; no <= pim.nNonOrthogonalCorrectors; ++no) {
         updatePressureGradient();
         assemblePressure(/*matrix=*/corr == 0 && no == 0);
-        if (corr == 0 && no == 0) linear_.pressureValuesChanged(exec_, Ap_);
+        if (corr == 0 && no == 0 && pressureLattice_ == nullptr) linear_.pressureValuesChanged(exec_, Ap_);
         ScopedRegion r3("mfsi::fluid::pressure::solve");
         // rAU, hence the matrix, is the same for every corrector of one outer iteration.
         const int refresh = opt_.pressurePreconditioner == PressurePreconditioner::Jacobi

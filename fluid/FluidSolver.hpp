@@ -41,6 +41,8 @@ namespace mfsi::fluid {
 struct PhiHbyAFace;
 /// Device functor writing the face fluxes from the solved pressure (FluidSolver.cpp).
 struct PressureFaceFlux;
+/// The row walker of the fused pressure-matrix passes (FluidSolver.cpp).
+struct PressureRow;
 
 /// \brief What one call of `solve()` did.
 struct StepResult {
@@ -160,6 +162,11 @@ class FluidSolver {
   /// The matrix and the source's divergence of fluxP_ in one pass over the cells; with `stored`
   /// the face coefficients come from coefP_.
   void assemblePressureMatrixFused(bool stored);
+  /// assemblePressureMatrixFused writing CG's symmetric lattice (diagonal and +x, +y, +z
+  /// couplings) instead of the CSR values: one coefficient per face, so symmetric by construction.
+  void assemblePressureLatticeFused(SymmetricLatticeMatrix& lattice, bool stored);
+  /// The row walker both fused pressure-matrix passes share.
+  PressureRow pressureRow(bool stored) const;
   void assemblePressureMatrixFaces();
   void pinPressureLevel();
   bool fusedPressureSource() const;
@@ -223,6 +230,9 @@ class FluidSolver {
   /// yet seen), and whether a later one has needed so many more that the next assembly refreshes.
   int refreshBaselineIterations_ = -1;
   bool pressureRefreshDue_ = false;
+  /// Set when the last pressure-matrix assembly wrote CG's lattice (owned by linear_), not Ap_'s
+  /// CSR values (stale until the linear solver fills them for a preconditioner refresh).
+  SymmetricLatticeMatrix* pressureLattice_ = nullptr;
   bool bdf2Active_ = false;
   /// gradP_ (and pb_) match the current p_, boundary pressures and geometry: the gradient is the
   /// same in every place that asks for it until one of those changes (see invalidations).

@@ -75,6 +75,8 @@ void LinearSolver::momentumMatrixChanged(const ExecSpace& exec, const CsrMatrix&
 }
 
 void LinearSolver::pressureMatrixChanged(const ExecSpace& exec, const CsrMatrix& A) {
+  // Values assembled into CG's lattice only: the preconditioner reads A's CSR values.
+  if (pSolver_->lattice().assembledFor(A)) pSolver_->lattice().writeCsr(exec, A);
   if (pReady_)
     pPrec_->updateValues(exec, A);
   else
@@ -85,6 +87,13 @@ void LinearSolver::pressureMatrixChanged(const ExecSpace& exec, const CsrMatrix&
 void LinearSolver::pressureValuesChanged(const ExecSpace& exec, const CsrMatrix& A) {
   pSolver_->matrixChanged(exec, A);
 }
+
+SymmetricLatticeMatrix* LinearSolver::pressureLattice(const CsrMatrix& A) {
+  SymmetricLatticeMatrix& L = pSolver_->lattice();
+  return L.prepare(A) ? &L : nullptr;
+}
+
+void LinearSolver::pressureLatticeAssembled(const CsrMatrix& A) { pSolver_->lattice().markAssembled(A); }
 
 LinearSolveStats LinearSolver::solveMomentum(const ExecSpace& exec, const CsrMatrix& A, const ConstRealView& b,
                                              const RealView& x, const LinearSolverOptions& o) {

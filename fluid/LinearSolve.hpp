@@ -60,6 +60,13 @@ class LinearSolver {
   /// (CG's symmetric lattice copy). Call after every assembly of the values, also between
   /// preconditioner refreshes.
   void pressureValuesChanged(const ExecSpace& exec, const CsrMatrix& A);
+  /// \brief CG's lattice for an assembly that writes the pressure matrix's values there instead
+  /// of into A's CSR values (see SymmetricLatticeMatrix::prepare), or nullptr when A's sparsity
+  /// is not a lattice. After writing: `pressureLatticeAssembled(A)` (instead of
+  /// `pressureValuesChanged`). `pressureMatrixChanged` then fills A's CSR values from the lattice
+  /// first.
+  SymmetricLatticeMatrix* pressureLattice(const CsrMatrix& A);
+  void pressureLatticeAssembled(const CsrMatrix& A);
   /// \brief Solve the momentum system A x = b (x holds the initial guess).
   LinearSolveStats solveMomentum(const ExecSpace& exec, const CsrMatrix& A, const ConstRealView& b, const RealView& x,
                                  const LinearSolverOptions& o);

@@ -141,6 +141,9 @@ class ConjugateGradient final : public KrylovSolver {
   const SymmetricLatticeMatrix* latticeCopy(const CsrMatrix& A) const {
     return lattice_.matches(A) ? &lattice_ : nullptr;
   }
+  /// \brief The lattice itself, for a caller that assembles into it directly (see
+  /// SymmetricLatticeMatrix::prepare).
+  SymmetricLatticeMatrix& lattice() { return lattice_; }
 
  private:
   KrylovResult run(const ExecSpace& exec, const CsrMatrix& A, const ConstRealView& b, const RealView& x,

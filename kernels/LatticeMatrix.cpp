@@ -1,5 +1,6 @@
 #include "kernels/LatticeMatrix.hpp"
 
+#include "core/Error.hpp"
 #include "kernels/Amg.hpp"
 
 #include <string>
@@ -106,7 +107,7 @@ bool SymmetricLatticeMatrix::matches(const CsrMatrix& A) const {
          A.colIdx.data() == colIdx_.data() && A.values.data() == values_.data();
 }
 
-bool SymmetricLatticeMatrix::update(const ExecSpace& exec, const CsrMatrix& A) {
+bool SymmetricLatticeMatrix::prepare(const CsrMatrix& A) {
   const bool sameSparsity = rowPtr_.data() != nullptr && A.nRows == nRows_ && A.nnz() == nnz_ &&
                             A.rowPtr.data() == rowPtr_.data() && A.colIdx.data() == colIdx_.data();
   if (!sameSparsity) {
@@ -134,7 +135,48 @@ bool SymmetricLatticeMatrix::update(const ExecSpace& exec, const CsrMatrix& A) {
   }
   values_ = A.values;
   valid_ = false;
-  if (!lattice_) return false;
+  assembled_ = false;
+  return lattice_;
+}
+
+void SymmetricLatticeMatrix::markAssembled(const CsrMatrix& A) {
+  MFSI_CHECK(lattice_ && A.nRows == nRows_ && A.nnz() == nnz_ && A.rowPtr.data() == rowPtr_.data() &&
+                 A.colIdx.data() == colIdx_.data(),
+             "SymmetricLatticeMatrix::markAssembled: prepare() was not called for this matrix's lattice sparsity");
+  values_ = A.values;
+  valid_ = true;
+  assembled_ = true;
+}
+
+void SymmetricLatticeMatrix::writeCsr(const ExecSpace& exec, const CsrMatrix& A) const {
+  MFSI_CHECK(matches(A), "SymmetricLatticeMatrix::writeCsr: the lattice does not hold this matrix");
+  // One lattice line per work item, as the copy in `update`: row i holds, in column order,
+  // [-sz if z > 0] [-sy if y > 0] [-1 if x > 0] diag [+1] [+sy] [+sz]; a lower coupling is the
+  // upper one of the row it couples to.
+  const lid_t nx = nx_, ny = ny_, nz = nz_, sy = nx_, sz = nx_ * ny_;
+  const ConstIndexView rowPtr = A.rowPtr;
+  const RealView val = A.values;
+  const ConstRealView d = diag_, ux = ux_, uy = uy_, uz = uz_;
+  Kokkos::parallel_for(
+      "mfsi::kernels::lattice::writeCsr", RangePolicy(exec, 0, ny * nz), KOKKOS_LAMBDA(lid_t line) {
+        const lid_t z = line / ny, y = line - z * ny;
+        const lid_t base = line * nx;
+        for (lid_t xx = 0; xx < nx; ++xx) {
+          const lid_t i = base + xx;
+          lid_t k = rowPtr(i);
+          if (z > 0) val(k++) = uz(i - sz);
+          if (y > 0) val(k++) = uy(i - sy);
+          if (xx > 0) val(k++) = ux(i - 1);
+          val(k++) = d(i);
+          if (xx + 1 < nx) val(k++) = ux(i);
+          if (y + 1 < ny) val(k++) = uy(i);
+          if (z + 1 < nz) val(k) = uz(i);
+        }
+      });
+}
+
+bool SymmetricLatticeMatrix::update(const ExecSpace& exec, const CsrMatrix& A) {
+  if (!prepare(A)) return false;
 
   // Copy the diagonal and upper couplings, one lattice line (fixed y, z) per work item so that
   // the CSR positions follow from the line's coordinates without divisions: row i at (x, y, z)

@@ -45,8 +45,28 @@ class SymmetricLatticeMatrix {
   bool update(const ExecSpace& exec, const CsrMatrix& A);
 
   /// \brief Whether the copy was made by the last `update` from this matrix's views (rowPtr,
-  /// colIdx, values) and A is a symmetric lattice matrix.
+  /// colIdx, values) and A is a symmetric lattice matrix, or was assembled for A (`markAssembled`).
   bool matches(const CsrMatrix& A) const;
+
+  /// \brief Direct assembly, for a caller that forms A's values itself (symmetric by
+  /// construction, e.g. one coefficient per face): `prepare(A)` detects A's lattice (once per
+  /// sparsity, as `update`) without reading A's values and returns whether it is one; the caller
+  /// then writes `diagonal()` and the upper couplings (0 where a coupling leaves the lattice) and
+  /// calls `markAssembled(A)`. A's CSR values are not written: they stay stale until
+  /// `writeCsr(exec, A)` fills them from the lattice (for CSR consumers such as a multigrid
+  /// set-up). No symmetry check is made: the caller guarantees it. Saves `update`'s copy pass and
+  /// the assembly's CSR writes (32 instead of 56 B per row).
+  bool prepare(const CsrMatrix& A);
+  void markAssembled(const CsrMatrix& A);
+  /// \brief Whether the lattice holds A's values by `markAssembled` (so A's CSR values may be stale).
+  bool assembledFor(const CsrMatrix& A) const { return assembled_ && matches(A); }
+  /// \brief A's CSR values from the lattice (both halves of each coupling).
+  void writeCsr(const ExecSpace& exec, const CsrMatrix& A) const;
+  /// \brief The arrays `prepare` allocated (nRows entries each; upperZ empty when nz = 1).
+  RealView diagonal() const { return diag_; }
+  RealView upperX() const { return ux_; }
+  RealView upperY() const { return uy_; }
+  RealView upperZ() const { return uz_; }
 
   /// \brief Whether the last `update` produced a usable copy.
   bool valid() const { return valid_; }
@@ -82,6 +102,7 @@ class SymmetricLatticeMatrix {
   // Values the copy was made from (held, as above).
   RealView values_;
   bool valid_ = false;
+  bool assembled_ = false;  ///< values written by a caller (markAssembled), not copied by update
   RealView diag_, ux_, uy_, uz_;  ///< uz_ empty when nz = 1
 };
 

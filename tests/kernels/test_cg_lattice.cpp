@@ -322,3 +322,42 @@ TEST(CgLattice, LaneReductionMatchesHostSum) {
 }
 
 }  // namespace
+
+TEST(CgLattice, DirectAssemblyAndCsrRoundTrip) {
+  // An assembly that writes the lattice itself (prepare, the arrays, markAssembled): the lattice
+  // then stands for A although A's CSR values are stale, and writeCsr gives back the CSR values
+  // bitwise (both halves of every coupling, in 3D and one cell thick).
+  const mfsi::ExecSpace exec;
+  for (const std::array<lid_t, 3> e : {std::array<lid_t, 3>{9, 8, 7}, std::array<lid_t, 3>{11, 6, 1}}) {
+    const auto A = latticeMatrix(e, true);
+    const HostVec want = HostCsr(A).values;
+    mfsi::SymmetricLatticeMatrix copy;
+    ASSERT_TRUE(copy.update(exec, A));
+    // B: A's sparsity with zeroed values; its lattice is written from the copy's arrays.
+    mfsi::CsrMatrix B = A;
+    B.values = mfsi::RealView("test::B::values", A.nnz());
+    mfsi::SymmetricLatticeMatrix L;
+    EXPECT_THROW(L.markAssembled(B), std::exception) << "markAssembled before prepare";
+    ASSERT_TRUE(L.prepare(B));
+    EXPECT_FALSE(L.matches(B));
+    Kokkos::deep_copy(L.diagonal(), copy.diagonal());
+    Kokkos::deep_copy(L.upperX(), copy.upperX());
+    Kokkos::deep_copy(L.upperY(), copy.upperY());
+    if (e[2] > 1) Kokkos::deep_copy(L.upperZ(), copy.upperZ());
+    L.markAssembled(B);
+    EXPECT_TRUE(L.matches(B) && L.assembledFor(B));
+    EXPECT_FALSE(copy.assembledFor(A)) << "a copy made by update is not an assembly";
+    // The lattice stands for B: its product is A's although B's CSR values are still zero.
+    const mfsi::RealView x = mfsi::test::roughVector(A.nRows, false);
+    mfsi::RealView y("test::y", A.nRows);
+    L.spmv(exec, x, y);
+    EXPECT_LE(mfsi::test::relDiff(mfsi::test::host(y), HostCsr(A).apply(mfsi::test::host(x))), 1e-14);
+    EXPECT_EQ(HostCsr(B).values, HostVec(A.nnz(), 0.0));
+    L.writeCsr(exec, B);
+    EXPECT_EQ(HostCsr(B).values, want) << e[0] << "x" << e[1] << "x" << e[2];
+    // A new copy from CSR ends the assembly state.
+    ASSERT_TRUE(L.update(exec, B));
+    EXPECT_FALSE(L.assembledFor(B));
+    EXPECT_TRUE(L.matches(B));
+  }
+}
