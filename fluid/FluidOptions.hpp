@@ -191,7 +191,7 @@ struct FluidOptions {
   real pressureFinalRelTol = -1.0;
   /// AMG smoother applications on the finest level in the pressure solves before the final one of
   /// a step (the final one uses one). Those solves stop at relTol; a second application there
-  /// costs ~1 ms per V-cycle on the 64^3 cavity and ends icoFoam's relTol = 0.05 solve after 2
+  /// costs ~1.4 ms per V-cycle on the 64^3 cavity (1 thread) and ends icoFoam's relTol = 0.05 solve after 2
   /// instead of 3 AMG-CG iterations (after 2 with one application its residual is 0.05-0.1 of the
   /// initial one). In the final solve it saves ~0.1 iterations, less than it costs.
   int pressureFinestSweeps = 2;

@@ -1138,7 +1138,8 @@ void FluidSolver::assemblePressure(bool matrix) {
     pressureSourceFluxFaces();
   if (fusedMatrix) {
     // CG's lattice takes the values directly when the sparsity is a lattice (no CSR values, no
-    // copy pass: 64^3 cavity ~2 ms per step); lines of one cell (nx or ny = 1) keep CSR.
+    // copy pass: 64^3 cavity ~3 ms per step at 1 thread); lines of one cell (nx or ny = 1) keep
+    // CSR.
     SymmetricLatticeMatrix* lattice = linear_.pressureLattice(Ap_);
     pressureLattice_ = lattice != nullptr && lattice->nx() > 1 && lattice->ny() > 1 ? lattice : nullptr;
     if (pressureLattice_ != nullptr)
