@@ -102,15 +102,17 @@ inline void latticeRowsHost(const LatticePtrs& P, lid_t i0, lid_t i1, const doub
 
 void SymmetricLatticeMatrix::clear() { *this = SymmetricLatticeMatrix(); }
 
+bool SymmetricLatticeMatrix::holdsSparsityOf(const CsrMatrix& A) const {
+  return rowPtr_.data() != nullptr && A.nRows == nRows_ && A.nnz() == nnz_ && A.rowPtr.data() == rowPtr_.data() &&
+         A.colIdx.data() == colIdx_.data();
+}
+
 bool SymmetricLatticeMatrix::matches(const CsrMatrix& A) const {
-  return valid_ && A.nRows == nRows_ && A.nnz() == nnz_ && A.rowPtr.data() == rowPtr_.data() &&
-         A.colIdx.data() == colIdx_.data() && A.values.data() == values_.data();
+  return valid_ && holdsSparsityOf(A) && A.values.data() == values_.data();
 }
 
 bool SymmetricLatticeMatrix::prepare(const CsrMatrix& A) {
-  const bool sameSparsity = rowPtr_.data() != nullptr && A.nRows == nRows_ && A.nnz() == nnz_ &&
-                            A.rowPtr.data() == rowPtr_.data() && A.colIdx.data() == colIdx_.data();
-  if (!sameSparsity) {
+  if (!holdsSparsityOf(A)) {
     // New sparsity: detect its lattice once (host copy of the sparsity: a set-up cost).
     clear();
     rowPtr_ = A.rowPtr;
@@ -140,8 +142,7 @@ bool SymmetricLatticeMatrix::prepare(const CsrMatrix& A) {
 }
 
 void SymmetricLatticeMatrix::markAssembled(const CsrMatrix& A) {
-  MFSI_CHECK(lattice_ && A.nRows == nRows_ && A.nnz() == nnz_ && A.rowPtr.data() == rowPtr_.data() &&
-                 A.colIdx.data() == colIdx_.data(),
+  MFSI_CHECK(lattice_ && holdsSparsityOf(A),
              "SymmetricLatticeMatrix::markAssembled: prepare() was not called for this matrix's lattice sparsity");
   values_ = A.values;
   valid_ = true;

@@ -94,6 +94,8 @@ class SymmetricLatticeMatrix {
   void clear();
 
  private:
+  /// Whether A has the sparsity views the lattice was detected for.
+  bool holdsSparsityOf(const CsrMatrix& A) const;
   // Sparsity the lattice was detected for (held: their addresses identify it).
   IndexView rowPtr_, colIdx_;
   lid_t nRows_ = 0, nnz_ = 0;
