@@ -2,6 +2,10 @@ MAKEFLAGS += --no-print-directory
 # Thin driver around CMake. The two commands of the README:
 #   make run    set-up -> configure -> build -> run the default scene
 #   make test   set-up -> configure -> build -> ctest
+# Portability and correctness builds (scripts/build-variant.sh, each in its own build directory):
+#   make build-cuda    CUDA + OpenMP Kokkos, nvcc_wrapper: compiles and links every target (no GPU run)
+#   make test-asan     AddressSanitizer + UndefinedBehaviorSanitizer build, whole test suite
+#   make test-bounds   Kokkos bounds-checked (debug) build, whole test suite
 # Options: BUILD_DIR=build  JOBS=<n>  SCENE=<file or name>  KOKKOS_ROOT=<your Kokkos>
 BUILD_DIR ?= build
 JOBS ?= $(shell nproc)
@@ -14,7 +18,7 @@ ifdef KOKKOS_ROOT
   KOKKOS_ARG = -DKokkos_ROOT=$(KOKKOS_ROOT)
 endif
 
-.PHONY: all deps configure build run test bench clean
+.PHONY: all deps configure build run test bench clean build-cuda test-asan test-bounds
 
 all: build
 
@@ -37,5 +41,14 @@ test: build
 bench: build
 	@bash perf/run_benchmarks.sh $(BUILD_DIR)
 
+build-cuda:
+	@JOBS=$(JOBS) bash scripts/build-variant.sh cuda
+
+test-asan:
+	@JOBS=$(JOBS) bash scripts/build-variant.sh asan --test
+
+test-bounds:
+	@JOBS=$(JOBS) bash scripts/build-variant.sh bounds --test
+
 clean:
-	rm -rf $(BUILD_DIR) $(BUILD_DIR).deps.env
+	rm -rf $(BUILD_DIR) $(BUILD_DIR).deps.env build-cuda build-asan build-bounds

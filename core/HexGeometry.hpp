@@ -8,7 +8,7 @@
 /// x det J (degree <= 3) exactly.
 #include <Kokkos_Core.hpp>
 
-#include <cmath>
+#include "core/Types.hpp"
 
 namespace mfsi::geom {
 
@@ -22,7 +22,7 @@ KOKKOS_INLINE_FUNCTION double dot(const double a[3], const double b[3]) {
   return a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
 }
 
-KOKKOS_INLINE_FUNCTION double norm(const double a[3]) { return std::sqrt(dot(a, a)); }
+KOKKOS_INLINE_FUNCTION double norm(const double a[3]) { return kmath::sqrt(dot(a, a)); }
 
 KOKKOS_INLINE_FUNCTION double det3(const double a[3], const double b[3], const double c[3]) {
   double bc[3];

@@ -148,7 +148,6 @@ HexMesh buildHexMesh(const HexMeshInput& in) {
   // Output patch list: the declared patches, then the default patch, then baffle sides.
   std::vector<Patch> patches;
   for (const auto& ps : in.patches) patches.push_back({ps.name, ps.kind, 0, 0, -1});
-  int defaultIdx = -1;
   std::vector<std::vector<std::pair<lid_t, int>>> patchFaces(in.patches.size());
   std::vector<std::pair<lid_t, int>> defaultFaces;
   for (const auto& [key, cf] : boundary) {
@@ -161,7 +160,6 @@ HexMesh buildHexMesh(const HexMeshInput& in) {
     }
   }
   if (!defaultFaces.empty()) {
-    defaultIdx = static_cast<int>(patches.size());
     patches.push_back({in.defaultPatch, PatchKind::Wall, 0, 0, -1});
     patchFaces.push_back(defaultFaces);
   }
@@ -230,7 +228,6 @@ HexMesh buildHexMesh(const HexMeshInput& in) {
     patchFaces.push_back(ms);
     patchFaces.push_back(ss);
   }
-  (void)defaultIdx;
 
   // --- assemble face arrays ---------------------------------------------------------------------
   std::sort(keptInternal.begin(), keptInternal.end(), [](const InternalFace& a, const InternalFace& b) {

@@ -234,6 +234,36 @@ struct PressureFaceFlux {
   }
 };
 
+// The constructor's kernels: nvcc takes no device lambda in a constructor (its address cannot be
+// taken), so they are free functions.
+namespace {
+
+/// Boundary faces whose velocity is taken from their cell (slip, empty, pressure).
+lid_t countVelocityFromCells(const ExecSpace& exec, const ConstIndexView& kind, lid_t nB) {
+  lid_t n = 0;
+  Kokkos::parallel_reduce(
+      "mfsi::fluid::bc::countVelocityFromCells", RangePolicy(exec, 0, nB),
+      KOKKOS_LAMBDA(lid_t b, lid_t & acc) {
+        const int kd = kind(b);
+        acc += (kd == kFaceSlip || kd == kFaceEmpty || kd == kFacePressure) ? 1 : 0;
+      },
+      n);
+  return n;
+}
+
+/// U = u0 in every cell.
+void fillVelocity(const ExecSpace& exec, const Real3View& U, const Vec3& u0) {
+  const real u0x = u0[0], u0y = u0[1], u0z = u0[2];
+  Kokkos::parallel_for(
+      "mfsi::fluid::init", RangePolicy(exec, 0, static_cast<lid_t>(U.extent(0))), KOKKOS_LAMBDA(lid_t c) {
+        U(c, 0) = u0x;
+        U(c, 1) = u0y;
+        U(c, 2) = u0z;
+      });
+}
+
+}  // namespace
+
 FluidSolver::FluidSolver(const HexMesh& mesh, const FluidOptions& options)
     : mesh_(mesh),
       opt_(options),
@@ -265,18 +295,7 @@ FluidSolver::FluidSolver(const HexMesh& mesh, const FluidOptions& options)
   bc_ = BoundaryConditions(mesh, opt_);
   boundaryCells_ = boundaryCells(mesh);
   for (const auto& rp : bc_.patches()) hasResistance_ = hasResistance_ || rp.type == BoundaryType::Resistance;
-  {
-    ConstIndexView kind = bc_.kind();
-    lid_t n = 0;
-    Kokkos::parallel_reduce(
-        "mfsi::fluid::bc::countVelocityFromCells", RangePolicy(exec_, 0, nB_),
-        KOKKOS_LAMBDA(lid_t b, lid_t & acc) {
-          const int kd = kind(b);
-          acc += (kd == kFaceSlip || kd == kFaceEmpty || kd == kFacePressure) ? 1 : 0;
-        },
-        n);
-    boundaryVelocityReadsU_ = n > 0;
-  }
+  boundaryVelocityReadsU_ = countVelocityFromCells(exec_, bc_.kind(), nB_) > 0;
   linear_ = LinearSolver(nCells_, opt_.pressurePreconditioner);
 
   U_ = Real3View("mfsi::fluid::U", nCells_);
@@ -315,14 +334,7 @@ FluidSolver::FluidSolver(const HexMesh& mesh, const FluidOptions& options)
   Kokkos::deep_copy(exec_, V0_, geo_.cellVolume);
   Kokkos::deep_copy(exec_, V00_, geo_.cellVolume);
 
-  const real u0x = opt_.initialVelocity[0], u0y = opt_.initialVelocity[1], u0z = opt_.initialVelocity[2];
-  auto U = U_;
-  Kokkos::parallel_for(
-      "mfsi::fluid::init", RangePolicy(exec_, 0, nCells_), KOKKOS_LAMBDA(lid_t c) {
-        U(c, 0) = u0x;
-        U(c, 1) = u0y;
-        U(c, 2) = u0z;
-      });
+  fillVelocity(exec_, U_, opt_.initialVelocity);
   Kokkos::deep_copy(exec_, p_, opt_.initialPressure);
   Kokkos::deep_copy(exec_, p0_, opt_.initialPressure);
   Kokkos::deep_copy(exec_, p00_, opt_.initialPressure);

@@ -124,7 +124,11 @@ class FluidSolver {
   /// Number of `beginStep` calls so far.
   int stepIndex() const { return nSteps_; }
 
- private:
+ public:
+  // --- the steps of solve() ----------------------------------------------------------------
+  // Public only because nvcc compiles extended device lambdas (KOKKOS_LAMBDA) solely in public
+  // member functions (CUDA Programming Guide, extended-lambda restrictions). They expect the state
+  // that beginStep() and solve() set up around them: not API; call the methods above.
   void updateGeometry();
   void computeTimeCoefficients();
   void computeMeshFlux();
@@ -188,6 +192,7 @@ class FluidSolver {
   real finishStep(real& sum, bool& finite, bool ddtStored);
   bool fieldsFinite();
 
+ private:
   const HexMesh& mesh_;
   FluidOptions opt_;
   ExecSpace exec_;

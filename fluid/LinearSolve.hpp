@@ -86,9 +86,12 @@ class LinearSolver {
   real pressureStepAlong(const ExecSpace& exec, const CsrMatrix& A, const ConstRealView& b, const ConstRealView& x,
                          const ConstRealView& d);
 
- private:
+  /// \brief One Krylov solve with the statistics the solves above report (their shared step).
+  /// Public only because nvcc compiles extended device lambdas solely in public member functions.
   LinearSolveStats solve(const ExecSpace& exec, KrylovSolver& solver, Preconditioner& M, const CsrMatrix& A,
                          const ConstRealView& b, const RealView& x, const LinearSolverOptions& o);
+
+ private:
 
   std::unique_ptr<Preconditioner> uPrec_, pPrec_;
   std::unique_ptr<KrylovSolver> uSolver_;

@@ -149,7 +149,7 @@ inline void jacobiRun3(const blas::detail::RunView& R, lid_t run, const double* 
   static_assert(!kHostExec || std::is_same<Real3View::array_layout, Kokkos::LayoutRight>::value,
                 "host n x 3 views are row-major");
   blas::detail::forRunRows(R, run, [&](lid_t i, const double* v, const lid_t* off, auto width) {
-    double s0 = 0.0, s1 = 0.0, s2 = 0.0;
+    [[maybe_unused]] double s0 = 0.0, s1 = 0.0, s2 = 0.0;  // the columns outside Mask stay unused
     for (int k = 0; k < width; ++k) {
       const lid_t j = i + off[k];
       const double a = v[k] * inv[j];

@@ -145,9 +145,12 @@ class ConjugateGradient final : public KrylovSolver {
   /// SymmetricLatticeMatrix::prepare).
   SymmetricLatticeMatrix& lattice() { return lattice_; }
 
- private:
+  /// \brief The iteration behind both `solve` overloads (r0: the given initial residual, or null).
+  /// Public only because nvcc compiles extended device lambdas solely in public member functions.
   KrylovResult run(const ExecSpace& exec, const CsrMatrix& A, const ConstRealView& b, const RealView& x,
                    Preconditioner& M, const InitialResidual* r0);
+
+ private:
   RealView r_, z_, p_, q_;
   SymmetricLatticeMatrix lattice_;
 };
@@ -161,9 +164,12 @@ class BiCGStab final : public KrylovSolver {
   KrylovResult solve(const ExecSpace& exec, const CsrMatrix& A, const ConstRealView& b, const RealView& x,
                      Preconditioner& M, const InitialResidual& r0) override;
 
- private:
+  /// \brief The iteration behind both `solve` overloads (r0: the given initial residual, or null).
+  /// Public only because nvcc compiles extended device lambdas solely in public member functions.
   KrylovResult run(const ExecSpace& exec, const CsrMatrix& A, const ConstRealView& b, const RealView& x,
                    Preconditioner& M, const InitialResidual* r0);
+
+ private:
   RealView r_, rhat_, p_, v_, phat_, shat_, t_;
 };
 
@@ -213,9 +219,12 @@ class BiCGStab3 {
   /// \brief Per-column options (e.g. a 1-norm tolerance scaled per velocity component).
   void setOptions(const std::array<KrylovOptions, 3>& options) { options_ = options; }
 
- private:
+  /// \brief The iteration behind both `solve` overloads (r0: the given initial residual, or null).
+  /// Public only because nvcc compiles extended device lambdas solely in public member functions.
   std::array<KrylovResult, 3> run(const ExecSpace& exec, const CsrMatrix& A, const ConstReal3View& b,
                                   const Real3View& x, const ConstRealView& invDiag, const InitialResidual3* r0);
+
+ private:
   std::array<KrylovOptions, 3> options_;
   SolverComm comm_;
   Real3View r_, rhat_, p_, v_, t_;

@@ -99,7 +99,11 @@ class MembraneSolver {
   const MembraneConstraints& constraints() const { return constraints_; }
   real characteristicLength() const { return lchar_; }
 
- private:
+ public:
+  // --- the steps of the solves -------------------------------------------------------------
+  // Public only because nvcc compiles extended device lambdas (KOKKOS_LAMBDA) solely in public
+  // member functions (CUDA Programming Guide, extended-lambda restrictions). They expect the state
+  // the solves above set up around them: not API.
   struct Norms {
     real free = 0, reaction = 0, external = 0;
   };
@@ -120,6 +124,7 @@ class MembraneSolver {
   MembraneSolveReport newtonSolve(real time, real loadFactor);
   MembraneSolveReport lumpedSolve(real time, real loadFactor);
 
+ private:
   MembraneMesh mesh_;
   MembraneOptions options_;
   MembraneBoundary boundary_;

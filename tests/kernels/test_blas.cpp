@@ -4,6 +4,7 @@
 #include "kernels/CsrBuild.hpp"
 #include "support/Approx.hpp"
 
+#include <array>
 #include <cmath>
 #include <limits>
 #include <random>
@@ -207,16 +208,26 @@ TEST(Blas, VectorUpdatesMatchHostGold) {
   EXPECT_TRUE(allNear(toHost(dy), g, kRows, Tol{0, 0}, "fill"));
 }
 
-TEST(Blas, FusedReduceReturnsSeveralSums) {
-  const HostVec x = randomVec(kRows, 14);
-  auto dx = toDevice(x);
-  mfsi::ExecSpace exec;
-  const auto s = mfsi::blas::reduce<3>(
+namespace {
+
+/// sum x, sum x^2 and the count in one fused reduction (a free function: nvcc compiles device
+/// lambdas only in public or free functions, and a TEST body is a private member).
+std::array<double, 3> sumsOf(const mfsi::ExecSpace& exec, const mfsi::RealView& dx) {
+  return mfsi::blas::reduce<3>(
       exec, mfsi::SolverComm(), "test::reduce3", kRows, KOKKOS_LAMBDA(lid_t i, mfsi::blas::Sums<3> & acc) {
         acc[0] += dx(i);
         acc[1] += dx(i) * dx(i);
         acc[2] += 1.0;
       });
+}
+
+}  // namespace
+
+TEST(Blas, FusedReduceReturnsSeveralSums) {
+  const HostVec x = randomVec(kRows, 14);
+  auto dx = toDevice(x);
+  mfsi::ExecSpace exec;
+  const auto s = sumsOf(exec, dx);
   double s0 = 0;
   for (double v : x) s0 += v;
   EXPECT_TRUE(near(s[0], s0, kTight, "sum"));

@@ -299,16 +299,23 @@ TEST(CgLattice, CopyIsNotUsedForAnotherMatrix) {
   }
 }
 
+/// u.v and |u|_1 by the lane reduction (a free function: nvcc compiles device lambdas only in
+/// public or free functions, and a TEST body is a private member).
+std::array<double, 2> laneSums(const mfsi::ExecSpace& exec, const mfsi::SolverComm& comm, lid_t n,
+                               const mfsi::RealView& u, const mfsi::RealView& v) {
+  return mfsi::blas::reduceLanes<2>(
+      exec, comm, "test::lanes", n, KOKKOS_LAMBDA(lid_t i, mfsi::blas::Sums<2> & acc) {
+        acc[0] += u(i) * v(i);
+        acc[1] += mfsi::kmath::fabs(u(i));
+      });
+}
+
 TEST(CgLattice, LaneReductionMatchesHostSum) {
   const mfsi::ExecSpace exec;
   const mfsi::SolverComm comm;
   for (const lid_t n : {1, 3, 256, 1027}) {  // partial lanes, one block, a partial last block
     const mfsi::RealView u = mfsi::test::roughVector(n, false, 0), v = mfsi::test::roughVector(n, false, 1);
-    const auto s = mfsi::blas::reduceLanes<2>(
-        exec, comm, "test::lanes", n, KOKKOS_LAMBDA(lid_t i, mfsi::blas::Sums<2> & acc) {
-          acc[0] += u(i) * v(i);
-          acc[1] += mfsi::kmath::fabs(u(i));
-        });
+    const auto s = laneSums(exec, comm, n, u, v);
     const HostVec uh = mfsi::test::host(u), vh = mfsi::test::host(v);
     long double d = 0, a = 0, scale = 0;
     for (lid_t i = 0; i < n; ++i) {

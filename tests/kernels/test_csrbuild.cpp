@@ -6,6 +6,7 @@
 #include "core/Error.hpp"
 #include "core/MeshGeometry.hpp"
 #include "support/Approx.hpp"
+#include "support/FvLaplacian.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -150,30 +151,7 @@ TEST(CsrBuild, FaceMapAssemblesTheFiniteVolumeLaplacian) {
   mfsi::ExecSpace exec;
   mfsi::computeGeometry(exec, mesh, geo);
   const auto cc = mfsi::buildCellCsr(mesh);
-  const auto offs = mesh.cellFaceOffsets();
-  const auto faces = mesh.cellFaces();
-  const auto owner = mesh.faceOwner(), neigh = mesh.faceNeighbour();
-  const auto pn = cc.faceMap.ownerRow, np = cc.faceMap.neighbourRow;
-  const auto diag = cc.matrix.diagIdx;
-  const auto val = cc.matrix.values;
-  const auto area = geo.faceAreaMag;
-  const auto cen = geo.cellCentroid;
-  const lid_t nIf = mesh.nInternalFaces();
-  Kokkos::parallel_for(
-      "test::assemble", mfsi::RangePolicy(exec, 0, mesh.nCells()), KOKKOS_LAMBDA(lid_t c) {
-        double d = 0;
-        for (lid_t k = offs(c); k < offs(c + 1); ++k) {
-          const lid_t f = faces(k);
-          if (f >= nIf) continue;
-          const lid_t P = owner(f), N = neigh(f);
-          const double dx = cen(N, 0) - cen(P, 0), dy = cen(N, 1) - cen(P, 1), dz = cen(N, 2) - cen(P, 2);
-          const double coef = area(f) / mfsi::kmath::sqrt(dx * dx + dy * dy + dz * dz);
-          val(c == P ? pn(f) : np(f)) = -coef;
-          d += coef;
-        }
-        val(diag(c)) = d;
-      });
-  exec.fence();
+  mfsi::test::assembleFvLaplacian(exec, mesh, geo, cc);
   // On the uniform 4^3 cube mesh of h = 1/4: coefficients h^2 / h = 1/4, so 4 A is the Neumann
   // model matrix up to the cell numbering; compare the sorted row patterns and the values.
   const auto model = mfsi::buildPoisson7({4, 4, 4}, mfsi::ModelBoundary::Neumann);
