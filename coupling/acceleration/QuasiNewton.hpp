@@ -1,0 +1,72 @@
+#pragma once
+/// \file
+/// \brief Interface quasi-Newton acceleration: the history of iterate differences, its QR
+/// factorisation and filter (QuasiNewton), and the least-squares inverse Jacobian (IqnIls).
+#include "coupling/acceleration/Aitken.hpp"
+
+#include <deque>
+
+namespace mfsi::coupling {
+
+/// \brief What every interface quasi-Newton method shares (preCICE's BaseQNAcceleration in spirit).
+///
+/// History: after each coupling pass k of a step (k >= 1) the column pair v = r_k - r_{k-1},
+/// w = xt_k - xt_{k-1} joins the front (newest first); at most iqnMaxCols are kept, and columns of
+/// the last iqnReuseCols steps survive beginStep. Columns are stored unscaled; the factorisation
+/// works on block-scaled columns S v (each block divided by the norm of its residual at the
+/// step's first pass, so membrane displacements and body DOFs weigh alike), rebuilt at every
+/// update by modified Gram-Schmidt with the QR2 filter, which drops for good any column whose
+/// part orthogonal to the newer ones is below iqnFilterEps of its norm.
+class QuasiNewton : public Acceleration {
+ public:
+  QuasiNewton(const AccelerationOptions& options, std::vector<InterfaceBlock> layout, const SolverComm& comm);
+  void beginStep() override;
+  /// Columns in the history now.
+  int columns() const { return static_cast<int>(columns_.size()); }
+
+ protected:
+  struct Column {
+    InterfaceVector v, w;
+    long step = 0;  ///< the time step it was made in
+  };
+  /// The thin QR factorisation S V = Q R of the filtered history.
+  struct Factorisation {
+    std::vector<InterfaceVector> q;
+    Eigen::MatrixXd r;
+  };
+
+  void restart() override;
+  /// Add the newest column pair (from the previous pass) and trim the history.
+  void record(const InterfaceVector& xt, const InterfaceVector& r);
+  /// Factorise the scaled history; drops filtered columns; returns how many it dropped.
+  int factorise(Factorisation& f);
+  /// S a: the block scaling of this step.
+  InterfaceVector scaled(const InterfaceVector& a) const;
+  /// A relaxation step x <- x + omega r (Aitken's omega, or omegaInit without history).
+  void relax(const InterfaceVector& r, InterfaceVector& x, AccelerationReport& report);
+
+  std::deque<Column> columns_;
+  AitkenOmega aitken_;
+  long stepIndex_ = 0;
+
+ private:
+  void setScaling(const InterfaceVector& r);
+  Eigen::VectorXd blockWeight_;  ///< per block of layout_
+  bool havePrevious_ = false;
+  InterfaceVector rPrevious_, xtPrevious_;
+};
+
+/// \brief IQN-ILS (Degroote, Bathe & Vierendeels 2009): x <- xt + W alpha with alpha minimising
+/// |S (V alpha + r)|, i.e. the inverse Jacobian of the residual fitted to the history by least
+/// squares. On an affine H it reaches the fixed point once the history spans the residuals: at
+/// most n + 1 passes for n unknowns.
+class IqnIls final : public QuasiNewton {
+ public:
+  using QuasiNewton::QuasiNewton;
+
+ protected:
+  void step(const InterfaceVector& xt, const InterfaceVector& r, InterfaceVector& x,
+            AccelerationReport& report) override;
+};
+
+}  // namespace mfsi::coupling

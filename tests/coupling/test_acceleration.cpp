@@ -1,0 +1,247 @@
+// Coupling accelerations on fixed points with known answers: x = H(x) = A x + b.
+#include "coupling/acceleration/Acceleration.hpp"
+#include "coupling/acceleration/QuasiNewton.hpp"
+
+#include "core/Error.hpp"
+#include "support/Approx.hpp"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <random>
+#include <vector>
+
+using mfsi::coupling::AccelerationMethod;
+using mfsi::coupling::AccelerationOptions;
+using mfsi::coupling::AccelerationReport;
+using mfsi::coupling::InterfaceBlock;
+using mfsi::coupling::InterfaceVector;
+using mfsi::coupling::makeAcceleration;
+using mfsi::test::near;
+using mfsi::test::Tol;
+
+namespace {
+
+/// An affine map whose plain fixed-point iteration diverges: A random with spectral radius ~1.5.
+struct Affine {
+  Eigen::MatrixXd A;
+  InterfaceVector b;
+  InterfaceVector operator()(const InterfaceVector& x) const { return A * x + b; }
+  InterfaceVector solution() const {
+    const Eigen::Index n = A.rows();
+    return (Eigen::MatrixXd::Identity(n, n) - A).fullPivLu().solve(b);
+  }
+};
+
+Affine randomAffine(int n, unsigned seed, double radius = 1.5) {
+  std::mt19937 gen(seed);
+  std::normal_distribution<double> nd;
+  Affine h{Eigen::MatrixXd(n, n), InterfaceVector(n)};
+  for (int i = 0; i < n; ++i) {
+    h.b[i] = nd(gen);
+    for (int j = 0; j < n; ++j) h.A(i, j) = nd(gen);
+  }
+  const double rho = h.A.eigenvalues().cwiseAbs().maxCoeff();
+  h.A *= radius / rho;
+  return h;
+}
+
+std::vector<InterfaceBlock> oneBlock(Eigen::Index n) { return {{"x", 0, n}}; }
+
+AccelerationOptions iqn(int maxCols, double filter) {
+  AccelerationOptions o;
+  o.method = AccelerationMethod::IqnIls;
+  o.iqnMaxCols = maxCols;
+  o.iqnFilterEps = filter;
+  o.omegaInit = 0.5;
+  o.stallIterations = 0;  // the residual of a quasi-Newton sequence need not fall monotonically
+  return o;
+}
+
+/// Aitken from omega 0.5, bounded below by 0.05.
+AccelerationOptions aitken() {
+  AccelerationOptions o;
+  o.method = AccelerationMethod::Aitken;
+  o.omegaInit = 0.5;
+  o.omegaMin = 0.05;
+  return o;
+}
+
+}  // namespace
+
+TEST(Acceleration, PlainIterationOfTheTestMapDiverges) {
+  // The test problem is hard on purpose: without acceleration the iterates grow.
+  const Affine h = randomAffine(8, 1);
+  AccelerationOptions o;
+  o.method = AccelerationMethod::Constant;
+  o.omegaInit = 1.0;
+  auto acc = makeAcceleration(o, oneBlock(8));
+  acc->beginStep();
+  InterfaceVector x = InterfaceVector::Zero(8);
+  for (int k = 0; k < 40; ++k) acc->update(h(x), x);
+  EXPECT_GT((x - h.solution()).norm(), 1e3 * h.solution().norm());
+}
+
+TEST(Acceleration, IqnIlsSolvesAnAffineFixedPointInAtMostNPlusOnePasses) {
+  for (const int n : {1, 3, 8, 12}) {
+    const Affine h = randomAffine(n, 10 + n);
+    const InterfaceVector xs = h.solution();
+    auto acc = makeAcceleration(iqn(2 * n, 1e-10), oneBlock(n));
+    acc->beginStep();
+    InterfaceVector x = InterfaceVector::Zero(n);
+    double errAfterTwo = 0;
+    for (int k = 1; k <= n + 1; ++k) {
+      const AccelerationReport rep = acc->update(h(x), x);
+      EXPECT_EQ(rep.columns, k - 1) << "n " << n << " pass " << k;
+      if (k == 2) errAfterTwo = (x - xs).norm() / xs.norm();
+    }
+    EXPECT_LT((x - xs).norm(), 1e-9 * xs.norm()) << "n = " << n << ": not at the fixed point after n + 1 passes";
+    if (n > 2) {
+      EXPECT_GT(errAfterTwo, 1e-3) << "n = " << n << ": the problem is too easy to show anything";
+    }
+  }
+}
+
+TEST(Acceleration, IqnIlsWithTheDefaultFilterStillConverges) {
+  const int n = 12;
+  const Affine h = randomAffine(n, 99);
+  const InterfaceVector xs = h.solution();
+  auto acc = makeAcceleration(iqn(50, AccelerationOptions{}.iqnFilterEps), oneBlock(n));
+  acc->beginStep();
+  InterfaceVector x = InterfaceVector::Zero(n);
+  int k = 0;
+  while (k < 3 * n && (h(x) - x).norm() > 1e-10 * xs.norm()) {
+    acc->update(h(x), x);
+    ++k;
+  }
+  EXPECT_LT((h(x) - x).norm(), 1e-10 * xs.norm()) << "after " << k << " passes";
+  EXPECT_LE(k, 2 * n);
+}
+
+TEST(Acceleration, AitkenFindsTheSecantOfAScalarStrongAddedMassMap) {
+  // H(x) = a x + b with a = -9: the map of a structure 9x lighter than its added mass; plain
+  // iteration diverges, the exact relaxation is 1 / (1 - a) = 0.1, which Aitken finds at its second
+  // pass and which lands on the fixed point.
+  const double a = -9, b = 2, xs = b / (1 - a);
+  auto acc = makeAcceleration(aitken(), oneBlock(1));
+  acc->beginStep();
+  InterfaceVector x = InterfaceVector::Zero(1);
+  auto H = [&](const InterfaceVector& y) { return InterfaceVector::Constant(1, a * y[0] + b); };
+  EXPECT_DOUBLE_EQ(acc->update(H(x), x).omega, 0.5);
+  const AccelerationReport second = acc->update(H(x), x);
+  EXPECT_TRUE(near(second.omega, 0.1, Tol{1e-14, 0}, "omega"));
+  EXPECT_TRUE(near(x[0], xs, Tol{1e-14, 0}, "x"));
+}
+
+TEST(Acceleration, AitkenOmegaStaysInItsBounds) {
+  // H(x) = a x + b with a = -99: the exact relaxation 0.01 is below omegaMin = 0.05, so omega stops
+  // at the bound (and the iteration, 1 - 0.05 * 100 = -4 per pass, diverges: the bound is honoured).
+  auto acc = makeAcceleration(aitken(), oneBlock(1));
+  acc->beginStep();
+  InterfaceVector x = InterfaceVector::Zero(1);
+  for (int k = 0; k < 5; ++k) {
+    const auto rep = acc->update(InterfaceVector::Constant(1, -99 * x[0] + 1), x);
+    EXPECT_GE(rep.omega, 0.05);
+    EXPECT_LE(rep.omega, 1.0);
+    if (k > 0) {
+      EXPECT_DOUBLE_EQ(rep.omega, 0.05);
+    }
+  }
+}
+
+TEST(Acceleration, TheLimiterReplacesAnOversizedQuasiNewtonStepByRelaxation) {
+  const int n = 6;
+  const Affine h = randomAffine(n, 5);
+  AccelerationOptions o = iqn(10, 1e-10);
+  o.maxUpdate = 1e-6;  // every quasi-Newton step is larger than this
+  auto acc = makeAcceleration(o, oneBlock(n));
+  acc->beginStep();
+  InterfaceVector x = InterfaceVector::Zero(n);
+  acc->update(h(x), x);  // first pass: relaxation, no history
+  const InterfaceVector before = x, xt = h(x);
+  const AccelerationReport rep = acc->update(xt, x);
+  EXPECT_TRUE(rep.fellBack);
+  EXPECT_EQ(rep.columns, 0);
+  EXPECT_GE(rep.omega, o.omegaMin);
+  EXPECT_LT((x - (before + rep.omega * (xt - before))).norm(), 1e-14 * x.norm());
+}
+
+TEST(Acceleration, AStalledResidualRestartsTheHistory) {
+  // H(x) = x + c: the residual is c whatever x is, so it never falls below its first value.
+  const int n = 4;
+  AccelerationOptions o = iqn(10, 1e-2);
+  o.stallIterations = 3;  // (the default is 10)
+  auto acc = makeAcceleration(o, oneBlock(n));
+  acc->beginStep();
+  InterfaceVector x = InterfaceVector::Zero(n);
+  const InterfaceVector c = InterfaceVector::LinSpaced(n, 1, 2);
+  std::vector<int> restarts;
+  for (int k = 1; k <= 8; ++k)
+    if (acc->update(x + c, x).restarted) restarts.push_back(k);
+  EXPECT_EQ(restarts, (std::vector<int>{4, 7}));
+}
+
+TEST(Acceleration, ReusedColumnsChangeIterationsNotResults) {
+  // A sequence of time steps: the same A, a slowly changing b. With the columns of earlier steps
+  // reused, later steps need fewer passes; the converged answers agree to the tolerance.
+  const int n = 10;
+  const double tol = 1e-10;
+  Affine h = randomAffine(n, 3, 0.9);
+  const InterfaceVector b0 = h.b;
+  auto run = [&](int reuse, std::vector<InterfaceVector>& answers) {
+    AccelerationOptions o = iqn(30, 1e-2);
+    o.iqnReuseCols = reuse;
+    auto acc = makeAcceleration(o, oneBlock(n));
+    InterfaceVector x = InterfaceVector::Zero(n);
+    int passes = 0;
+    for (int step = 0; step < 6; ++step) {
+      h.b = b0 * (1.0 + 0.05 * step);
+      acc->beginStep();
+      for (int k = 0; k < 60 && (h(x) - x).norm() > tol * x.norm(); ++k, ++passes) acc->update(h(x), x);
+      answers.push_back(x);
+    }
+    return passes;
+  };
+  std::vector<InterfaceVector> fresh, reused;
+  const int passesFresh = run(0, fresh), passesReused = run(2, reused);
+  EXPECT_LT(passesReused, passesFresh);
+  for (std::size_t s = 0; s < fresh.size(); ++s)
+    EXPECT_LT((fresh[s] - reused[s]).norm(), 10 * tol * fresh[s].norm()) << "step " << s;
+}
+
+TEST(Acceleration, BlockScalingMakesIqnIlsIndependentOfUnits) {
+  // Two blocks (say metres and radians); expressing the second in units 1e6 times smaller
+  // (y2 = 1e6 x2) must not change the iteration: the same iterates up to the change of units.
+  const int n = 8, n1 = 5;
+  const Affine h = randomAffine(n, 21);
+  Eigen::VectorXd d = Eigen::VectorXd::Ones(n);
+  d.tail(n - n1).setConstant(1e6);
+  const std::vector<InterfaceBlock> layout = {{"membrane", 0, n1}, {"body", n1, n - n1}};
+  auto a1 = makeAcceleration(iqn(20, 1e-2), layout);
+  auto a2 = makeAcceleration(iqn(20, 1e-2), layout);
+  a1->beginStep();
+  a2->beginStep();
+  InterfaceVector x = InterfaceVector::Zero(n), y = InterfaceVector::Zero(n);
+  for (int k = 0; k < n + 1; ++k) {
+    a1->update(h(x), x);
+    const InterfaceVector hy = d.asDiagonal() * h(d.cwiseInverse().asDiagonal() * y);
+    a2->update(hy, y);
+    const InterfaceVector back = d.cwiseInverse().asDiagonal() * y;
+    EXPECT_LT((back - x).norm(), 1e-9 * x.norm()) << "pass " << k + 1;
+  }
+}
+
+TEST(Acceleration, TheFactoryAndTheOptionChecks) {
+  AccelerationOptions o;
+  o.iqnMaxCols = 4;  // selects IQN-ILS whatever the method says
+  auto acc = makeAcceleration(o, oneBlock(3));
+  EXPECT_NE(dynamic_cast<mfsi::coupling::IqnIls*>(acc.get()), nullptr);
+  o = AccelerationOptions{};
+  o.omegaInit = 0;
+  EXPECT_THROW(makeAcceleration(o, oneBlock(3)), mfsi::InputError);
+  o = AccelerationOptions{};
+  auto aitken = makeAcceleration(o, oneBlock(3));
+  InterfaceVector x = InterfaceVector::Zero(3);
+  const InterfaceVector wrong = InterfaceVector::Zero(4);
+  EXPECT_THROW(aitken->update(wrong, x), mfsi::InputError);
+}
