@@ -1,0 +1,65 @@
+#pragma once
+/// \file
+/// \brief Interior mesh motion by Jacobi point-Laplacian smoothing of the displacement from the
+/// reference mesh (the seed's section 3.3), with a quality guard.
+///
+/// The orchestrator writes the displacement of every boundary node (membrane nodes from the
+/// structure, frame and wall nodes from their bodies or zero) into `displacement()`, then calls
+/// `move`: the interior nodes' displacement is smoothed from its last value (warm start), the
+/// points become reference + displacement, and the minimum scaled Jacobian is checked. Smoothing
+/// the displacement, not the positions, keeps a graded mesh whose boundary does not move
+/// bit-identical (zero stays exactly zero), and a warm start needs few sweeps per FSI iteration.
+#include "core/MeshGeometry.hpp"
+#include "kernels/JacobiSmoothing.hpp"
+
+#include <cstdint>
+
+namespace mfsi::coupling {
+
+struct MeshSmootherOptions {
+  int sweeps = 50;  ///< Jacobi sweeps per motion
+  /// Quality guard: below this minimum scaled Jacobian the motion is retried (more sweeps, then the
+  /// stiffened smoother); an inverted cell (<= 0) after every retry stops the run.
+  double minScaledJacobian = 0.05;
+  /// Retries: the first ones double the sweeps each time; the last uses the stiffened smoother,
+  /// whose edge weights 1 / L^2 (L the reference edge length) make small cells move more rigidly.
+  int retries = 3;
+};
+
+/// \brief What one `move` did.
+struct MotionReport {
+  int sweeps = 0;  ///< sweeps of the accepted motion
+  int retries = 0;
+  bool stiffened = false;
+  double minScaledJacobian = 0;
+};
+
+class MeshSmoother {
+ public:
+  /// Every node of a boundary face (walls, inlets, baffle sides, ...) is prescribed; the others
+  /// are smoothed. The mesh must outlive the smoother; `move` moves its points.
+  MeshSmoother(const HexMesh& mesh, const MeshSmootherOptions& options);
+
+  /// Displacement of every node from the reference mesh [m]: set the prescribed (boundary) entries
+  /// before `move`; interior entries hold the last smoothed values.
+  Real3View displacement() const { return d_; }
+  /// 1 for prescribed nodes.
+  Kokkos::View<const std::uint8_t*, MemSpace> prescribed() const { return fixed_; }
+
+  /// Smooth, move the mesh points and recompute `geo`; the quality guard retries as the options
+  /// say. Throws DivergenceError when a cell is still inverted, with the mesh (points, geometry,
+  /// displacement) restored to the last accepted motion.
+  MotionReport move(const ExecSpace& exec, MeshGeometry& geo);
+
+  /// Points = reference + d (one kernel; no fence).
+  void place(const ExecSpace& exec, const ConstReal3View& d) const;
+
+ private:
+  const HexMesh& mesh_;
+  MeshSmootherOptions options_;
+  Kokkos::View<std::uint8_t*, MemSpace> fixed_;
+  SmoothingGraph graph_, stiff_;
+  Real3View d_, work_, start_, good_;
+};
+
+}  // namespace mfsi::coupling

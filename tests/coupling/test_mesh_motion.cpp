@@ -1,0 +1,94 @@
+// Mesh motion by displacement smoothing: zero motion is exact, a large wall deflection keeps every
+// cell valid, an impossible one is refused with the mesh left as it was.
+#include "coupling/motion/MeshSmoother.hpp"
+
+#include "core/BlockMesh.hpp"
+#include "core/Error.hpp"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+using mfsi::lid_t;
+using mfsi::coupling::MeshSmoother;
+using mfsi::coupling::MeshSmootherOptions;
+
+namespace {
+
+mfsi::HexMesh gradedBox(int n, double gz) {
+  mfsi::BlockMeshSpec spec = mfsi::boxSpec({0, 0, 0}, {1, 1, 1}, {n, n, n});
+  spec.blocks[0].grading = {1, 1, gz};
+  return mfsi::buildHexMesh(mfsi::generateBlockMesh(spec));
+}
+
+/// Bottom-wall nodes (z = 0) get the upward bump a sin(pi x) sin(pi y); every other entry is zeroed.
+void bottomBump(const MeshSmoother& s, const mfsi::HexMesh& mesh, double a) {
+  auto hd = Kokkos::create_mirror_view(s.displacement());
+  auto hx = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), mesh.referencePoints());
+  for (lid_t i = 0; i < mesh.nNodes(); ++i) {
+    hd(i, 0) = hd(i, 1) = hd(i, 2) = 0;
+    if (std::abs(hx(i, 2)) < 1e-12) hd(i, 2) = a * std::sin(M_PI * hx(i, 0)) * std::sin(M_PI * hx(i, 1));
+  }
+  Kokkos::deep_copy(s.displacement(), hd);
+}
+
+/// Thickness of the first cell row of a box of n cells graded gz along z.
+double firstCellThickness(int n, double gz) {
+  const double r = std::pow(gz, 1.0 / (n - 1));
+  return (r - 1) / (std::pow(r, n) - 1);
+}
+
+}  // namespace
+
+TEST(MeshMotion, ZeroMotionLeavesAGradedMeshBitIdentical) {
+  auto mesh = gradedBox(10, 8);
+  auto geo = mfsi::allocateGeometry(mesh);
+  MeshSmoother s(mesh, MeshSmootherOptions{});
+  mfsi::ExecSpace exec;
+  const auto rep = s.move(exec, geo);
+  exec.fence();
+  EXPECT_EQ(rep.retries, 0);
+  auto hx = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), mesh.points());
+  auto h0 = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), mesh.referencePoints());
+  for (lid_t i = 0; i < mesh.nNodes(); ++i)
+    for (int c = 0; c < 3; ++c) ASSERT_EQ(hx(i, c), h0(i, c)) << "node " << i;
+}
+
+TEST(MeshMotion, AWallDeflectionOfFiveCellThicknessesKeepsEveryCellValid) {
+  const int n = 16;
+  const double gz = 8, h0 = firstCellThickness(n, gz);
+  auto mesh = gradedBox(n, gz);
+  auto geo = mfsi::allocateGeometry(mesh);
+  MeshSmoother s(mesh, MeshSmootherOptions{});
+  bottomBump(s, mesh, 5 * h0);
+  mfsi::ExecSpace exec;
+  const auto rep = s.move(exec, geo);
+  EXPECT_GT(rep.minScaledJacobian, MeshSmootherOptions{}.minScaledJacobian);
+  // The wall really moved by 5 first-cell thicknesses at its centre (node at x = y = 0.5).
+  auto hx = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), mesh.points());
+  auto hr = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), mesh.referencePoints());
+  double top = 0;
+  for (lid_t i = 0; i < mesh.nNodes(); ++i)
+    if (std::abs(hr(i, 2)) < 1e-12) top = std::max(top, hx(i, 2));
+  EXPECT_NEAR(top, 5 * h0, 1e-12);
+  // Moving only the wall nodes (no smoothing) would invert the first cell rows.
+  MeshSmoother none(mesh, MeshSmootherOptions{0, 0.05, 0});
+  bottomBump(none, mesh, 5 * h0);
+  EXPECT_THROW(none.move(exec, geo), mfsi::DivergenceError);
+}
+
+TEST(MeshMotion, AnImpossibleMotionIsRefusedAndTheMeshKeptAsItWas) {
+  auto mesh = gradedBox(8, 4);
+  auto geo = mfsi::allocateGeometry(mesh);
+  MeshSmoother s(mesh, MeshSmootherOptions{});
+  mfsi::ExecSpace exec;
+  bottomBump(s, mesh, 0.05);  // an accepted motion first
+  s.move(exec, geo);
+  exec.fence();
+  auto before = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), mesh.points());
+  bottomBump(s, mesh, 1.5);  // through the fixed top wall: no interior motion can save it
+  EXPECT_THROW(s.move(exec, geo), mfsi::DivergenceError);
+  auto after = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), mesh.points());
+  for (lid_t i = 0; i < mesh.nNodes(); ++i)
+    for (int c = 0; c < 3; ++c) ASSERT_EQ(after(i, c), before(i, c)) << "node " << i;
+}
