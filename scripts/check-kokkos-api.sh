@@ -44,22 +44,22 @@ fail=0
 files=$(find "$@" -type f \( -name '*.hpp' -o -name '*.cpp' -o -name '*.h' \) -not -path "$skip" | sort)
 while IFS=$'\t' read -r pattern why; do
   [ -n "$pattern" ] || continue
-  for f in $files; do
-    hits=$(grep -nE -- "$pattern" "$f" || true)
-    [ -n "$hits" ] || continue
-    while IFS= read -r hit; do
-      line=${hit%%:*}
-      # The sanctioned version branches: core/Types.hpp's 3.4 math aliases and the launch flag
-      # chosen by KOKKOS_VERSION in apps/mfsi.cpp (the line must sit in an #if on KOKKOS_VERSION).
-      if [[ "$f" == core/Types.hpp || "$f" == apps/mfsi.cpp ]]; then
-        branch=$(head -n "$line" "$f" | grep -nE '^#(if|elif|else|endif)' | tail -n1 || true)
-        if [[ "$branch" == *KOKKOS_VERSION* || "$branch" == *"#else"* ]]; then continue; fi
-      fi
-      echo "$f:$hit"
-      echo "    Kokkos 4: $why"
-      fail=1
-    done <<< "$hits"
-  done
+  hits=$(echo "$files" | xargs grep -nHE -- "$pattern" || true)
+  [ -n "$hits" ] || continue
+  while IFS= read -r hit; do
+    f=${hit%%:*}
+    rest=${hit#*:}
+    line=${rest%%:*}
+    # The sanctioned version branches: core/Types.hpp's 3.4 math aliases and the launch flag
+    # chosen by KOKKOS_VERSION in apps/mfsi.cpp (the line must sit in an #if on KOKKOS_VERSION).
+    if [[ "$f" == core/Types.hpp || "$f" == apps/mfsi.cpp ]]; then
+      branch=$(head -n "$line" "$f" | grep -nE '^#(if|elif|else|endif)' | tail -n1 || true)
+      if [[ "$branch" == *KOKKOS_VERSION* || "$branch" == *"#else"* ]]; then continue; fi
+    fi
+    echo "$hit"
+    echo "    Kokkos 4: $why"
+    fail=1
+  done <<< "$hits"
 done <<< "$rules"
 if [ "$fail" -ne 0 ]; then echo "check-kokkos-api: Kokkos 4 incompatibilities found (above)"; exit 1; fi
 echo "check-kokkos-api: $(echo "$files" | wc -l) files, no API that Kokkos 4 removed or renamed"

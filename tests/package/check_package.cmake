@@ -1,5 +1,7 @@
 # Install membrane-fsi into a scratch prefix, build a downstream project against it with
-# find_package(mfsi), run it. Arguments: BUILD (our build dir), SRC (this folder), WORK, KOKKOS_DIR.
+# find_package(mfsi), run it. Arguments: BUILD (our build dir), SRC (this folder), WORK, KOKKOS_DIR,
+# CXX_FLAGS and LINKER_FLAGS (our build's own, e.g. the sanitizers of build-variant.sh asan, which
+# the consumer must link with too).
 file(REMOVE_RECURSE ${WORK})
 execute_process(COMMAND ${CMAKE_COMMAND} --install ${BUILD} --prefix ${WORK}/prefix RESULT_VARIABLE rc OUTPUT_QUIET)
 if(NOT rc EQUAL 0)
@@ -9,7 +11,8 @@ file(MAKE_DIRECTORY ${WORK}/src)
 configure_file(${SRC}/CMakeLists.txt.in ${WORK}/src/CMakeLists.txt COPYONLY)
 configure_file(${SRC}/consumer.cpp ${WORK}/src/consumer.cpp COPYONLY)
 execute_process(COMMAND ${CMAKE_COMMAND} -S ${WORK}/src -B ${WORK}/build -DCMAKE_BUILD_TYPE=Release
-  "-DCMAKE_PREFIX_PATH=${WORK}/prefix" -DKokkos_DIR=${KOKKOS_DIR} RESULT_VARIABLE rc OUTPUT_VARIABLE o ERROR_VARIABLE e)
+  "-DCMAKE_PREFIX_PATH=${WORK}/prefix" -DKokkos_DIR=${KOKKOS_DIR} "-DCMAKE_CXX_FLAGS=${CXX_FLAGS}"
+  "-DCMAKE_EXE_LINKER_FLAGS=${LINKER_FLAGS}" RESULT_VARIABLE rc OUTPUT_VARIABLE o ERROR_VARIABLE e)
 if(NOT rc EQUAL 0)
   message(FATAL_ERROR "configure of the consumer failed:\n${o}\n${e}")
 endif()
