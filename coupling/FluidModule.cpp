@@ -36,6 +36,17 @@ FluidModule::FluidModule(const HexMesh& mesh, const FluidOptions& options, Fluid
 
 void FluidModule::advance(const TimeState& t) {
   last_ = solver_.solveStep(t.time, t.dt);
+  account(t);
+}
+
+void FluidModule::beginStep(const TimeState& t) { solver_.beginStep(t.time, t.dt); }
+
+void FluidModule::solveIteration(const TimeState& t) {
+  last_ = solver_.solve();
+  account(t);
+}
+
+void FluidModule::account(const TimeState& t) {
   outerTotal_ += last_.outerIterations;
   pressureTotal_ += last_.pressureIterations;
   momentumTotal_ += last_.momentumIterations;

@@ -16,6 +16,12 @@ class FluidModule final : public Module {
   /// One time step (steady: `pimple.outerCorrectors` SIMPLE iterations). Throws DivergenceError
   /// when the solver reports a breakdown or non-finite fields.
   void advance(const TimeState& t) override;
+  /// The steps of advance, for a module that iterates the fluid within a step (the coupling):
+  /// beginStep, then solveIteration once per coupling iteration (PIMPLE on the current mesh and
+  /// wall velocities, from the current iterate). solveIteration throws DivergenceError like advance.
+  void beginStep(const TimeState& t);
+  void solveIteration(const TimeState& t);
+  void endStep() {}
   /// fluid.* numbers: continuity, iteration totals, last residuals, forces, pressure differences,
   /// Ghia errors.
   void addMetrics(std::map<std::string, double>& metrics) const override;
@@ -26,6 +32,8 @@ class FluidModule final : public Module {
   const fluid::StepResult& lastStep() const { return last_; }
 
  private:
+  void account(const TimeState& t);  ///< totals and the divergence check of a solve
+
   fluid::FluidSolver solver_;
   FluidReports reports_;
   fluid::StepResult last_;

@@ -56,7 +56,10 @@ void MembraneModule::sample() {
   if (!finite) throw DivergenceError(name() + ": non-finite displacement at t = " + std::to_string(solver_->time()));
   maxU_ = std::sqrt(m2);
   centreW_ = 0;
-  for (int k = 0; k < 3; ++k) centreW_ += u(3 * centre_ + k) * centreNormal_[k];
+  for (int k = 0; k < 3; ++k) {
+    centreU_[k] = u(3 * centre_ + k);
+    centreW_ += centreU_[k] * centreNormal_[k];
+  }
 }
 
 void MembraneModule::check(const MembraneSolveReport& report, const char* what, double time) {
@@ -90,7 +93,7 @@ void MembraneModule::advance(const TimeState& t) {
 }
 
 std::vector<std::string> MembraneModule::stepColumns() const {
-  return {"iterations", "residual", "maxDisplacement", "centreDeflection"};
+  return {"iterations", "residual", "maxDisplacement", "centreDeflection", "centreUx", "centreUy", "centreUz"};
 }
 
 void MembraneModule::appendStepValues(std::vector<double>& values) const {
@@ -99,11 +102,15 @@ void MembraneModule::appendStepValues(std::vector<double>& values) const {
   values.push_back(r.relativeResidual);
   values.push_back(maxU_);
   values.push_back(centreW_);
+  values.insert(values.end(), {centreU_[0], centreU_[1], centreU_[2]});
 }
 
 void MembraneModule::addMetrics(std::map<std::string, double>& metrics) const {
   const std::string p = name() + ".";
   for (const auto& [k, v] : solver_->summary()) metrics[p + k] = v;
+  metrics[p + "centreUx"] = centreU_[0];
+  metrics[p + "centreUy"] = centreU_[1];
+  metrics[p + "centreUz"] = centreU_[2];
   const MembraneMaterial& m = panel_.options.material;
   if (panel_.reference == MembraneReference::Hencky) {
     // Hencky: w0 = C_w(nu) a (p a / (E h))^(1/3), along the load.

@@ -29,6 +29,10 @@ class MembraneModule final : public Module {
   void appendStepValues(std::vector<double>& values) const override;
 
   MembraneSolver& solver() { return *solver_; }
+  const MembraneSolver& solver() const { return *solver_; }
+  /// Re-read max |u| and the centre deflection of the current state (after another module moved
+  /// it, e.g. the coupling's commit). Throws DivergenceError on a non-finite displacement.
+  void sampleState() { sample(); }
   const MembranePanelOptions& panel() const { return panel_; }
 
  private:
@@ -42,6 +46,7 @@ class MembraneModule final : public Module {
   bool solved_ = false;
   real maxU_ = 0;
   real centreW_ = 0;
+  std::array<real, 3> centreU_{0, 0, 0};  ///< displacement of the centre node
   std::vector<double> history_;  ///< centre deflection at t = 0, dt, 2 dt, ... (dynamic)
   double dt_ = 0;
 };

@@ -3,6 +3,7 @@
 #include "coupling/FluidModule.hpp"
 #include "coupling/MembraneModule.hpp"
 #include "coupling/RigidModule.hpp"
+#include "coupling/orchestrator/FsiCoupling.hpp"
 
 namespace mfsi {
 
@@ -18,8 +19,10 @@ Module::Module(std::string name) : name_(std::move(name)) { ++counts()[name_]; }
 const std::map<std::string, int>& Module::constructionCounts() { return counts(); }
 
 const std::vector<ModuleEntry>& moduleCatalogue() {
-  // Physics modules register here as they land (fluid, membranes, bodies, coupling).
-  static const std::vector<ModuleEntry> catalogue = {fluidModuleEntry(), membraneModuleEntry(), rigidModuleEntry()};
+  // Physics modules register here as they land. The coupling comes last: it takes the modules it
+  // composes from those built before it.
+  static const std::vector<ModuleEntry> catalogue = {fluidModuleEntry(), membraneModuleEntry(), rigidModuleEntry(),
+                                                     couplingModuleEntry()};
   return catalogue;
 }
 

@@ -25,6 +25,8 @@ struct SimulationContext {
   HexMesh* mesh = nullptr;  ///< null when the scene has no `mesh` section
   MeshGeometry* geometry = nullptr;
   Timers* timers = nullptr;
+  /// The modules built so far: a module that composes others (the coupling) takes them from here.
+  std::vector<std::unique_ptr<class Module>>* built = nullptr;
 };
 
 class Module {
@@ -44,6 +46,9 @@ class Module {
   /// Column names and values of this module in steps.csv.
   virtual std::vector<std::string> stepColumns() const { return {}; }
   virtual void appendStepValues(std::vector<double>& /*values*/) const {}
+  /// Modules this one owns and advances itself (the coupling's fluid and membranes): the driver
+  /// asks them for output, columns and metrics, but never advances them.
+  virtual std::vector<Module*> parts() { return {}; }
 
   /// How many modules of each name were ever constructed in this process (for tests of the
   /// "a module the scene does not name costs nothing" rule).

@@ -41,10 +41,16 @@ Simulation::Simulation(const SceneConfig& scene) {
     ctx.geometry = &geometry_;
   }
   ctx.timers = &timers_;
+  ctx.built = &modules_;
   for (const auto& entry : moduleCatalogue()) {
     if (!scene.has(entry.section)) continue;  // not named: never constructed
     ScopedTimer t(timers_, "setup." + entry.section);
-    for (auto& m : entry.create(scene.child(entry.section), ctx)) modules_.push_back(std::move(m));
+    auto created = entry.create(scene.child(entry.section), ctx);
+    for (auto& m : created) modules_.push_back(std::move(m));
+  }
+  for (auto& m : modules_) {
+    reporting_.push_back(m.get());
+    for (Module* p : m->parts()) reporting_.push_back(p);
   }
   if (!hasMesh_ && modules_.empty())
     throw InputError(scene.where(), "the scene names nothing to simulate: give at least a 'mesh' or a physics section");
@@ -73,10 +79,10 @@ RunResult Simulation::run(const std::string& outDir, bool terminal) {
     if (time_.maxSteps > 0) nSteps = std::min<long long>(nSteps, time_.maxSteps);
   }
   std::vector<std::string> columns = {"step", "time", "wall_s"};
-  for (const auto& m : modules_)
+  for (const Module* m : reporting_)
     for (const auto& c : m->stepColumns()) columns.push_back(m->name() + "." + c);
   StepLog log(outDir + "/steps.csv", columns);
-  for (auto& m : modules_) m->openOutput(outDir);
+  for (Module* m : reporting_) m->openOutput(outDir);
   Progress progress(nSteps, time_.endTime, terminal);
   TimeState ts;
   ts.endTime = time_.endTime;
@@ -91,7 +97,7 @@ RunResult Simulation::run(const std::string& outDir, bool terminal) {
     ts.time += ts.dt;
     ++ts.step;
     std::vector<double> row = {double(ts.step), ts.time, wallSeconds() - start};
-    for (const auto& m : modules_) m->appendStepValues(row);
+    for (const Module* m : reporting_) m->appendStepValues(row);
     log.row(row);
     progress.update(ts.step, ts.time);
   }
@@ -101,7 +107,7 @@ RunResult Simulation::run(const std::string& outDir, bool terminal) {
   {
     ScopedTimer t(timers_, "metrics");
     meshMetrics(r.metrics);
-    for (const auto& m : modules_) m->addMetrics(r.metrics);
+    for (const Module* m : reporting_) m->addMetrics(r.metrics);
   }
   return r;
 }

@@ -46,7 +46,8 @@ class Simulation {
   HexMesh mesh_;
   MeshGeometry geometry_;
   TimeOptions time_;
-  std::vector<std::unique_ptr<Module>> modules_;
+  std::vector<std::unique_ptr<Module>> modules_;  ///< advanced by the driver
+  std::vector<Module*> reporting_;                ///< modules_ and their parts: output, columns, metrics
 };
 
 }  // namespace mfsi

@@ -47,7 +47,7 @@ FaceKind faceKindOf(BoundaryType t) {
 
 // Parabolic shape factor in [0, 1] at x (1 for a uniform profile).
 real shapeAt(const ResolvedPatch& rp, const real x[3]) {
-  if (rp.bc.profile != Profile::Parabolic) return 1.0;
+  if (rp.bc.profile != Profile::Parabolic && rp.bc.profile != Profile::Linear) return 1.0;
   real s = 1.0;
   for (int d = 0; d < 3; ++d) {
     if (!rp.bc.parabolicAxes[d]) continue;
@@ -57,7 +57,7 @@ real shapeAt(const ResolvedPatch& rp, const real x[3]) {
       hi = rp.boxMax[d];
     }
     const real xi = (x[d] - lo) / (hi - lo);
-    s *= std::max(0.0, 4.0 * xi * (1.0 - xi));
+    s *= rp.bc.profile == Profile::Linear ? std::clamp(xi, 0.0, 1.0) : std::max(0.0, 4.0 * xi * (1.0 - xi));
   }
   return s;
 }

@@ -11,8 +11,9 @@ using namespace fluid;
 
 namespace {
 
-const std::vector<std::string> kBoundaryTypes = {"fixedVelocity", "flowRate", "wall",          "movingWall",
-                                                 "slip",          "empty",    "fixedPressure", "resistance"};
+const std::vector<std::string> kBoundaryTypes = {"fixedVelocity", "flowRate",      "wall",      "movingWall",
+                                                 "membraneWall",  "slip",          "empty",     "fixedPressure",
+                                                 "resistance"};
 
 Schema linearSolverSchema(const std::string& what, double tolerance, int maxIter) {
   return Schema::map(what +
@@ -28,7 +29,7 @@ Schema boundarySchema() {
       .key("type",
            Schema::choice("fixedVelocity: prescribed velocity; flowRate: volumetric inflow along the inward normal; "
                           "wall: no-slip, tangential velocity `velocity` (a driven lid); movingWall: no-slip moving "
-                          "with the mesh; slip: free slip / symmetry; empty: front/back of a one-cell-thick 2D mesh; "
+                          "with the mesh; membraneWall: no-slip moving with the coupled membrane on it; slip: free slip / symmetry; empty: front/back of a one-cell-thick 2D mesh; "
                           "fixedPressure: p prescribed, zero-gradient velocity (outflow); resistance: p = resistance * "
                           "q + pressure, q the outflow rate",
                           kBoundaryTypes))
@@ -39,8 +40,9 @@ Schema boundarySchema() {
       .key("pressure", Schema::real("fixedPressure: p; resistance: p0", "Pa"), Default(0.0))
       .key("resistance", Schema::real("resistance: C_r", "Pa s/m^3").atLeast(0), Default(0.0))
       .key("profile",
-           Schema::choice("fixedVelocity/flowRate: shape across the patch; parabolic = prod 4 s (1 - s)",
-                          {"uniform", "parabolic"}),
+           Schema::choice("fixedVelocity/flowRate: shape across the patch, s in [0, 1] across the extent along "
+                          "each of parabolicAxes; parabolic = prod 4 s (1 - s); linear = prod s",
+                          {"uniform", "parabolic", "linear"}),
            Default("uniform"))
       .key("parabolicAxes",
            Schema::list("parabolic: axes the profile varies across", Schema::choice("axis", {"x", "y", "z"})),
@@ -111,8 +113,9 @@ PatchBC readBoundary(const SceneConfig& b) {
   const std::string type = b.get<std::string>("type");
   if (type == "fixedVelocity") bc.type = BoundaryType::FixedVelocity;
   if (type == "flowRate") bc.type = BoundaryType::FlowRate;
-  if (type == "wall" || type == "movingWall") bc.type = BoundaryType::Wall;
+  if (type == "wall" || type == "movingWall" || type == "membraneWall") bc.type = BoundaryType::Wall;
   if (type == "movingWall") bc.wallMotion = WallMotion::MeshVelocity;
+  if (type == "membraneWall") bc.wallMotion = WallMotion::External;  // velocity from the coupled membrane
   if (type == "slip") bc.type = BoundaryType::Slip;
   if (type == "empty") bc.type = BoundaryType::Empty;
   if (type == "fixedPressure") bc.type = BoundaryType::FixedPressure;
@@ -121,13 +124,15 @@ PatchBC readBoundary(const SceneConfig& b) {
   bc.flowRate = b.get<double>("flowRate");
   bc.pressure = b.get<double>("pressure");
   bc.resistance = b.get<double>("resistance");
-  bc.profile = b.get<std::string>("profile") == "parabolic" ? Profile::Parabolic : Profile::Uniform;
+  const std::string profile = b.get<std::string>("profile");
+  bc.profile = profile == "parabolic" ? Profile::Parabolic : profile == "linear" ? Profile::Linear : Profile::Uniform;
   const auto axes = b.get<std::vector<std::string>>("parabolicAxes");
   for (const auto& a : axes) bc.parabolicAxes[a[0] - 'x'] = true;
-  if (bc.profile == Profile::Parabolic && axes.empty())
-    throw InputError(b.where("profile"), "a parabolic profile needs 'parabolicAxes' (e.g. [y])");
-  if (bc.profile == Profile::Parabolic && bc.type != BoundaryType::FixedVelocity && bc.type != BoundaryType::FlowRate)
-    throw InputError(b.where("profile"), "a parabolic profile applies to fixedVelocity and flowRate patches only");
+  const bool shaped = bc.profile == Profile::Parabolic || bc.profile == Profile::Linear;
+  if (shaped && axes.empty())
+    throw InputError(b.where("profile"), "a " + profile + " profile needs 'parabolicAxes' (e.g. [y])");
+  if (shaped && bc.type != BoundaryType::FixedVelocity && bc.type != BoundaryType::FlowRate)
+    throw InputError(b.where("profile"), "a " + profile + " profile applies to fixedVelocity and flowRate patches only");
   bc.parabolicMin = vec3(b, "parabolicMin");
   bc.parabolicMax = vec3(b, "parabolicMax");
   if (b.has("timeFunction")) {

@@ -62,6 +62,7 @@ enum class BoundaryType {
 enum class Profile {
   Uniform,    ///< constant over the patch
   Parabolic,  ///< prod over `parabolicAxes` of 4 s (1 - s), s in [0, 1] across the patch extent, peak 1
+  Linear,     ///< prod over `parabolicAxes` of s: 0 at the low end of the extent, 1 at the high end
   Function,   ///< `velocityFunction(x, t)` (FixedVelocity only; the time function still multiplies it)
 };
 

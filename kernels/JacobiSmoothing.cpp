@@ -7,6 +7,8 @@ void jacobiSweep(const ExecSpace& exec, const SmoothingGraph& g, const ConstReal
   const auto fixed = g.fixed;
   const ConstRealView w = g.weights;
   const bool weighted = w.extent(0) > 0;
+  const ConstReal3View sn = g.slideNormal;
+  const bool sliding = sn.extent(0) > 0;
   Kokkos::parallel_for(
       "mfsi::kernels::smoothing::jacobiSweep", RangePolicy(exec, 0, g.nNodes()), KOKKOS_LAMBDA(lid_t i) {
         const lid_t k0 = off(i), k1 = off(i + 1);
@@ -24,9 +26,12 @@ void jacobiSweep(const ExecSpace& exec, const SmoothingGraph& g, const ConstReal
           ws += wk;
         }
         const real inv = real(1) / ws;
-        out(i, 0) = s0 * inv;
-        out(i, 1) = s1 * inv;
-        out(i, 2) = s2 * inv;
+        real m[3] = {s0 * inv - in(i, 0), s1 * inv - in(i, 1), s2 * inv - in(i, 2)};  // the update
+        if (sliding) {
+          const real dn = m[0] * sn(i, 0) + m[1] * sn(i, 1) + m[2] * sn(i, 2);
+          for (int c = 0; c < 3; ++c) m[c] -= dn * sn(i, c);
+        }
+        for (int c = 0; c < 3; ++c) out(i, c) = in(i, c) + m[c];
       });
 }
 

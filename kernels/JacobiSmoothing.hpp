@@ -12,11 +12,14 @@ namespace mfsi {
 /// \brief The graph a sweep walks. `offsets`/`neighbours`: CSR node -> node adjacency (e.g.
 /// HexMesh::nodeNodeOffsets / nodeNodes, the cell edges). `fixed(i) != 0`: node i keeps its
 /// value. `weights` (optional, one per adjacency entry): the weighted mean sum_j w_ij d_j / sum_j
-/// w_ij; empty: the plain mean over the neighbours.
+/// w_ij; empty: the plain mean over the neighbours. `slideNormal` (optional, one per node): a
+/// free node with a nonzero unit normal n moves in its tangent plane only (a mesh node sliding along
+/// a flat wall): its update is projected, v - (v.n) n, and its normal component keeps its value.
 struct SmoothingGraph {
   ConstIndexView offsets, neighbours;
   Kokkos::View<const std::uint8_t*, MemSpace> fixed;
   ConstRealView weights;
+  ConstReal3View slideNormal;
   lid_t nNodes() const { return offsets.extent(0) > 0 ? static_cast<lid_t>(offsets.extent(0)) - 1 : 0; }
 };
 

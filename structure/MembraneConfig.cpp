@@ -70,13 +70,18 @@ Schema meshSchemaOfPanel() {
                     .key("group", Schema::string("physical surface group (empty: all surface elements)"), Default(""));
   Schema baffles = Schema::map("surface taken from a baffle of the scene's fluid mesh (nodes shared with the fluid)")
                        .key("patch", Schema::string("baffle name (mesh.baffles name, without _master/_slave)"));
+  Schema onPatch =
+      Schema::map("surface taken from a one-sided boundary patch of the scene's fluid mesh (a wall the membrane "
+                  "replaces; normal out of the fluid); node sets xmin ... zmax of its bounding box")
+          .key("patch", Schema::string("patch name"));
   return Schema::map("surface mesh: exactly one generator")
       .key("rectangle", rectangle, Presence::OptionalSection)
       .key("disc", disc, Presence::OptionalSection)
       .key("annulus", annulus, Presence::OptionalSection)
       .key("sphere", sphere, Presence::OptionalSection)
       .key("gmsh", gmsh, Presence::OptionalSection)
-      .key("baffles", baffles, Presence::OptionalSection);
+      .key("baffles", baffles, Presence::OptionalSection)
+      .key("boundaryPatch", onPatch, Presence::OptionalSection);
 }
 
 Schema panelSchema() {
@@ -157,7 +162,12 @@ Schema panelSchema() {
                Schema::list("node sets moving only along their reference normal", Schema::string("node set")),
                Presence::Optional)
           .key("springs", Schema::list("node springs", spring), Presence::Optional)
-          .key("edgeBeams", Schema::list("edge reinforcements", beam), Presence::Optional);
+          .key("edgeBeams", Schema::list("edge reinforcements", beam), Presence::Optional)
+          .key("motionPlaneNormal",
+               Schema::realVector(3, "nonzero: unclamped nodes move perpendicular to it only (a one-cell-thick 2D "
+                                     "scene gives its thickness axis, e.g. [0, 0, 1])",
+                                  "-"),
+               Default(std::array<double, 3>{0, 0, 0}));
   Schema initial =
       Schema::map("initial displacement")
           .key("shape", Schema::choice("flat, or (rectangle) a sine mode along the normal", {"flat", "sineMode"}),
@@ -193,10 +203,11 @@ MembraneElementType elementType(const SceneConfig& c) {
 
 MembraneMeshSpec readMesh(const SceneConfig& m, const HexMesh* fluidMesh) {
   std::vector<std::string> given;
-  for (const auto& k : {"rectangle", "disc", "annulus", "sphere", "gmsh", "baffles"})
+  for (const auto& k : {"rectangle", "disc", "annulus", "sphere", "gmsh", "baffles", "boundaryPatch"})
     if (m.has(k)) given.push_back(k);
   if (given.size() != 1)
-    throw InputError(m.where(), "give exactly one mesh generator (rectangle, disc, annulus, sphere, gmsh, baffles), got " +
+    throw InputError(m.where(), "give exactly one mesh generator (rectangle, disc, annulus, sphere, gmsh, baffles, "
+                                "boundaryPatch), got " +
                                     (given.empty() ? std::string("none") : joinList(given)));
   MembraneMeshSpec s;
   const std::string g = given.front();
@@ -223,6 +234,21 @@ MembraneMeshSpec readMesh(const SceneConfig& m, const HexMesh* fluidMesh) {
       throw InputError(c.where("patch"), "the fluid mesh has no baffle '" + s.baffle + "'" + didYouMean(s.baffle, names) +
                                              "; baffles: " + (names.empty() ? std::string("none") : joinList(names)));
     }
+    return s;
+  }
+  if (g == "boundaryPatch") {
+    if (fluidMesh == nullptr)
+      throw InputError(c.where("patch"), "a membrane on a boundary patch needs the scene's 'mesh' section");
+    s.kind = MembraneMeshKind::Patch;
+    s.patch = c.get<std::string>("patch");
+    s.fluidMesh = fluidMesh;
+    const int pi = fluidMesh->findPatch(s.patch);
+    std::vector<std::string> names;
+    for (const auto& pt : fluidMesh->patches())
+      if (pt.kind != PatchKind::BaffleMaster && pt.kind != PatchKind::BaffleSlave) names.push_back(pt.name);
+    if (pi < 0 || std::find(names.begin(), names.end(), s.patch) == names.end())
+      throw InputError(c.where("patch"), "the fluid mesh has no one-sided boundary patch '" + s.patch + "'" +
+                                             didYouMean(s.patch, names) + "; patches: " + joinList(names));
     return s;
   }
   if (g == "rectangle") {
@@ -301,6 +327,7 @@ MembraneBoundarySpec readBoundary(const SceneConfig& b, const std::vector<std::s
   MembraneBoundarySpec s;
   s.clamp = b.get<std::vector<std::string>>("clamp");
   s.constrainToNormal = b.get<std::vector<std::string>>("constrainToNormal");
+  s.motionPlaneNormal = b.get<std::array<double, 3>>("motionPlaneNormal");
   for (std::size_t i = 0; i < s.clamp.size(); ++i) checkSet(b, "clamp." + std::to_string(i), s.clamp[i], known);
   for (std::size_t i = 0; i < s.constrainToNormal.size(); ++i)
     checkSet(b, "constrainToNormal." + std::to_string(i), s.constrainToNormal[i], known);
@@ -443,6 +470,8 @@ MembraneMeshInput generateMembraneMesh(const MembraneMeshSpec& spec) {
       return readGmshSurface(spec.gmshFile, spec.gmshGroup);
     case MembraneMeshKind::Baffle:
       return membraneMeshFromBaffle(*spec.fluidMesh, spec.baffle).mesh;
+    case MembraneMeshKind::Patch:
+      return membraneMeshFromPatch(*spec.fluidMesh, spec.patch).mesh;
   }
   return {};
 }
@@ -450,6 +479,7 @@ MembraneMeshInput generateMembraneMesh(const MembraneMeshSpec& spec) {
 MembraneBoundary resolveMembraneBoundary(const MembraneBoundarySpec& spec, const MembraneMesh& mesh) {
   MembraneBoundary b;
   for (const auto& s : spec.clamp) b.clamps.push_back({mesh.nodeSet(s), {}, {}});
+  b.motionPlaneNormal = spec.motionPlaneNormal;
   for (const auto& s : spec.constrainToNormal) {
     const auto& nodes = mesh.nodeSet(s);
     b.normalNodes.insert(b.normalNodes.end(), nodes.begin(), nodes.end());

@@ -27,7 +27,7 @@
 namespace mfsi {
 
 /// Mesh generator of a panel.
-enum class MembraneMeshKind { Rectangle, Disc, Annulus, Sphere, Gmsh, Baffle };
+enum class MembraneMeshKind { Rectangle, Disc, Annulus, Sphere, Gmsh, Baffle, Patch };
 
 /// \brief Which generator builds a panel's mesh, with its parameters (only the chosen one is used).
 struct MembraneMeshSpec {
@@ -39,7 +39,8 @@ struct MembraneMeshSpec {
   std::string gmshFile;       ///< Gmsh: surface mesh file (absolute or relative to the working folder)
   std::string gmshGroup;      ///< Gmsh: physical surface group ("" = every surface element)
   std::string baffle;         ///< Baffle: baffle name in the fluid mesh (without _master/_slave)
-  const HexMesh* fluidMesh = nullptr;  ///< Baffle: the scene's fluid mesh (not owned)
+  std::string patch;          ///< Patch: one-sided boundary patch of the fluid mesh
+  const HexMesh* fluidMesh = nullptr;  ///< Baffle, Patch: the scene's fluid mesh (not owned)
 };
 
 /// \brief Host mesh description of a spec (node sets included; "boundary" and "centre" are added
@@ -87,6 +88,7 @@ struct MembraneBoundarySpec {
   std::vector<std::string> constrainToNormal;
   std::vector<MembraneSetSprings> springs;
   std::vector<MembraneSetBeams> edgeBeams;
+  std::array<real, 3> motionPlaneNormal{0, 0, 0};  ///< see MembraneBoundary
 };
 
 /// \brief Node ids of a boundary spec on a mesh. Throws InputError for unknown node sets.

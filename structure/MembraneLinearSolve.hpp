@@ -13,7 +13,9 @@
 namespace mfsi {
 
 /// Per-node constraint kinds.
-enum class MembraneNodeConstraint : int { Free = 0, Fixed = 1, Direction = 2 };
+/// Free; Fixed; Direction: moves along `direction` only; Plane: moves perpendicular to `direction`
+/// only (e.g. the nodes of a one-cell-thick 2D scene, which stay in their z-plane).
+enum class MembraneNodeConstraint : int { Free = 0, Fixed = 1, Direction = 2, Plane = 3 };
 
 /// \brief Constraint projector: kind per node and the unit direction of Direction nodes.
 struct MembraneConstraints {
@@ -31,6 +33,11 @@ KOKKOS_INLINE_FUNCTION void projectNode(int kind, real n0, real n1, real n2, rea
     v[0] = s * n0;
     v[1] = s * n1;
     v[2] = s * n2;
+  } else if (kind == static_cast<int>(MembraneNodeConstraint::Plane)) {
+    const real s = v[0] * n0 + v[1] * n1 + v[2] * n2;
+    v[0] -= s * n0;
+    v[1] -= s * n1;
+    v[2] -= s * n2;
   }
 }
 }  // namespace membrane

@@ -14,7 +14,56 @@ namespace mfsi {
 
 // --- baffles ----------------------------------------------------------------------------------
 
-BaffleMembraneInput membraneMeshFromBaffle(const HexMesh& mesh, const std::string& baffleName) {
+namespace {
+
+/// One quad per face of [first, first + count), nodes numbered in order of first use (which keeps
+/// neighbours close: the faces come sorted by node key, and no global node scan is needed).
+FluidSurfaceMembraneInput surfaceFromFaces(const HexMesh& mesh, lid_t first, lid_t count, const std::string& source) {
+  auto faces = Kokkos::create_mirror_view_and_copy(HostSpace(), mesh.faceNodes());
+  auto points = Kokkos::create_mirror_view_and_copy(HostSpace(), mesh.referencePoints());
+  FluidSurfaceMembraneInput out;
+  out.mesh.source = source;
+  std::unordered_map<lid_t, lid_t> local;
+  for (lid_t f = first; f < first + count; ++f) {
+    std::array<lid_t, 4> q;
+    for (int a = 0; a < 4; ++a) {
+      const lid_t g = faces(f, a);
+      auto [it, inserted] = local.emplace(g, static_cast<lid_t>(out.fluidNode.size()));
+      if (inserted) {
+        out.fluidNode.push_back(g);
+        out.mesh.points.push_back({points(g, 0), points(g, 1), points(g, 2)});
+      }
+      q[a] = it->second;
+    }
+    out.mesh.elements.push_back(q);
+    out.masterFace.push_back(f);
+  }
+  // Bounding-box side sets, for clamping the ends of a strip or the edges of a panel by name.
+  std::array<real, 3> lo{1e300, 1e300, 1e300}, hi{-1e300, -1e300, -1e300};
+  for (const auto& p : out.mesh.points)
+    for (int k = 0; k < 3; ++k) {
+      lo[k] = std::min(lo[k], p[k]);
+      hi[k] = std::max(hi[k], p[k]);
+    }
+  real span = 0;
+  for (int k = 0; k < 3; ++k) span = std::max(span, hi[k] - lo[k]);
+  const real tol = 1e-9 * span;
+  const char* axis[3] = {"x", "y", "z"};
+  for (int k = 0; k < 3; ++k) {
+    if (!(hi[k] - lo[k] > tol)) continue;  // flat in this axis: both sides would be every node
+    std::vector<lid_t>& smin = out.mesh.nodeSets[std::string(axis[k]) + "min"];
+    std::vector<lid_t>& smax = out.mesh.nodeSets[std::string(axis[k]) + "max"];
+    for (lid_t n = 0; n < static_cast<lid_t>(out.mesh.points.size()); ++n) {
+      if (out.mesh.points[n][k] <= lo[k] + tol) smin.push_back(n);
+      if (out.mesh.points[n][k] >= hi[k] - tol) smax.push_back(n);
+    }
+  }
+  return out;
+}
+
+}  // namespace
+
+FluidSurfaceMembraneInput membraneMeshFromBaffle(const HexMesh& mesh, const std::string& baffleName) {
   ScopedRegion region("mfsi::structure::membraneMeshFromBaffle");
   const int master = mesh.findPatch(baffleName + "_master");
   if (master < 0 || mesh.patches()[master].kind != PatchKind::BaffleMaster) {
@@ -30,31 +79,27 @@ BaffleMembraneInput membraneMeshFromBaffle(const HexMesh& mesh, const std::strin
   const Patch& ps = mesh.patches()[pm.pairedPatch];
   MFSI_CHECK(ps.size == pm.size, mesh.source() << ": baffle '" << baffleName << "' has " << pm.size
                                                << " master but " << ps.size << " slave faces");
-
-  auto faces = Kokkos::create_mirror_view_and_copy(HostSpace(), mesh.faceNodes());
-  auto points = Kokkos::create_mirror_view_and_copy(HostSpace(), mesh.referencePoints());
-
-  BaffleMembraneInput out;
-  out.mesh.source = mesh.source() + ": baffle '" + baffleName + "'";
-  // Membrane node numbering: order of first use by the master faces, which keeps neighbours
-  // close (the faces come sorted by node key) and needs no global node scan.
-  std::unordered_map<lid_t, lid_t> local;
-  for (lid_t f = pm.start; f < pm.start + pm.size; ++f) {
-    std::array<lid_t, 4> q;
-    for (int a = 0; a < 4; ++a) {
-      const lid_t g = faces(f, a);
-      auto [it, inserted] = local.emplace(g, static_cast<lid_t>(out.fluidNode.size()));
-      if (inserted) {
-        out.fluidNode.push_back(g);
-        out.mesh.points.push_back({points(g, 0), points(g, 1), points(g, 2)});
-      }
-      q[a] = it->second;
-    }
-    out.mesh.elements.push_back(q);
-    out.masterFace.push_back(f);
+  FluidSurfaceMembraneInput out =
+      surfaceFromFaces(mesh, pm.start, pm.size, mesh.source() + ": baffle '" + baffleName + "'");
+  for (lid_t f = pm.start; f < pm.start + pm.size; ++f)
     out.slaveFace.push_back(ps.start + (f - pm.start));  // face i of one side pairs with face i of the other
-  }
   return out;
+}
+
+FluidSurfaceMembraneInput membraneMeshFromPatch(const HexMesh& mesh, const std::string& patchName) {
+  ScopedRegion region("mfsi::structure::membraneMeshFromPatch");
+  const int pi = mesh.findPatch(patchName);
+  const auto baffleSide = [](PatchKind k) { return k == PatchKind::BaffleMaster || k == PatchKind::BaffleSlave; };
+  if (pi < 0 || baffleSide(mesh.patches()[pi].kind)) {
+    std::string known;
+    for (const auto& p : mesh.patches())
+      if (!baffleSide(p.kind)) known += (known.empty() ? "" : ", ") + p.name;
+    MFSI_CHECK(false, mesh.source() << ": no one-sided boundary patch '" << patchName << "' (patches: "
+                                    << (known.empty() ? "none" : known) << ")");
+  }
+  const Patch& p = mesh.patches()[pi];
+  MFSI_CHECK(p.size > 0, mesh.source() << ": patch '" << patchName << "' has no faces");
+  return surfaceFromFaces(mesh, p.start, p.size, mesh.source() + ": patch '" + patchName + "'");
 }
 
 // --- Gmsh surfaces ----------------------------------------------------------------------------

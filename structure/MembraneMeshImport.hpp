@@ -12,21 +12,29 @@
 
 namespace mfsi {
 
-/// \brief A membrane cut out of a fluid mesh baffle, and how it maps back onto the fluid mesh.
-struct BaffleMembraneInput {
-  MembraneMeshInput mesh;        ///< quads in master-face node order (normal = baffle normal)
-  std::vector<lid_t> fluidNode;  ///< membrane node i -> fluid mesh node (size mesh.points.size())
-  std::vector<lid_t> masterFace; ///< membrane element e -> face of the "<name>_master" patch (mesh face id)
-  std::vector<lid_t> slaveFace;  ///< membrane element e -> the paired face of "<name>_slave"
+/// \brief A membrane cut out of the fluid mesh (a baffle or a one-sided boundary patch), and how
+/// it maps back onto the fluid mesh.
+struct FluidSurfaceMembraneInput {
+  MembraneMeshInput mesh;         ///< one quad per face, in the face's node order (normal = face normal)
+  std::vector<lid_t> fluidNode;   ///< membrane node i -> fluid mesh node (size mesh.points.size())
+  std::vector<lid_t> masterFace;  ///< membrane element e -> its face: of "<name>_master", or of the patch
+  std::vector<lid_t> slaveFace;   ///< baffle: element e -> the paired face of "<name>_slave"; patch: empty
 };
 
 /// \brief Membrane surface from the baffle `baffleName` of `mesh` (the name without the
 /// "_master"/"_slave" suffix). One quad per master face with the master face's node order, so
 /// the membrane normal is the baffle normal; nodes are numbered in order of first use and sit at
-/// the fluid mesh's reference positions. Node sets: "boundary" (the baffle's outer edge nodes)
-/// and "centre" are added by `buildMembraneMesh`. Throws InputError listing the baffles of the
-/// mesh when there is no such baffle.
-BaffleMembraneInput membraneMeshFromBaffle(const HexMesh& mesh, const std::string& baffleName);
+/// the fluid mesh's reference positions. Node sets: "xmin" ... "zmax" (the nodes on each side of
+/// the surface's bounding box, where it is not flat in that axis); "boundary" (the outer edge) and
+/// "centre" are added by `buildMembraneMesh`. Throws InputError listing the baffles of the mesh
+/// when there is no such baffle.
+FluidSurfaceMembraneInput membraneMeshFromBaffle(const HexMesh& mesh, const std::string& baffleName);
+
+/// \brief Membrane surface on the one-sided boundary patch `patchName` (a wall the membrane
+/// replaces: a cavity bottom, a tube wall). As for a baffle; the membrane normal is the patch's
+/// outward normal (out of the fluid), so a positive load pressure is the fluid pushing the wall
+/// out. Throws InputError listing the patches for an unknown name or a baffle side.
+FluidSurfaceMembraneInput membraneMeshFromPatch(const HexMesh& mesh, const std::string& patchName);
 
 /// \brief Read a membrane surface from a Gmsh MSH 4.1 ASCII file.
 ///

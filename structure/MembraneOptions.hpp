@@ -181,6 +181,10 @@ struct MembraneEdgeBeam {
 struct MembraneBoundary {
   std::vector<MembraneClamp> clamps;
   std::vector<lid_t> normalNodes;  ///< constrainToNormal: these move only along their reference normal
+  /// Nonzero: every node that is neither clamped nor normal-constrained moves perpendicular to this
+  /// direction only (normalised on use). A membrane of a one-cell-thick 2D fluid scene gives the
+  /// thickness axis, so its nodes stay in their planes.
+  std::array<real, 3> motionPlaneNormal{0, 0, 0};
   std::vector<MembraneNodeSpring> edgeSprings;
   std::vector<MembraneNodeSpring> cornerSprings;
   std::vector<MembraneEdgeBeam> edgeBeams;

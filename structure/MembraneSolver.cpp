@@ -136,7 +136,13 @@ void MembraneSolver::setupConstraints() {
   constraints_.direction = Real3View("mfsi::structure::membrane::constraintDirection", nN);
   auto hk = Kokkos::create_mirror_view(constraints_.kind);
   auto hd = Kokkos::create_mirror_view(constraints_.direction);
-  for (lid_t n = 0; n < nN; ++n) hk(n) = static_cast<int>(MembraneNodeConstraint::Free);
+  const auto& pn = boundary_.motionPlaneNormal;
+  const real pnLen = std::sqrt(pn[0] * pn[0] + pn[1] * pn[1] + pn[2] * pn[2]);
+  MFSI_CHECK(std::isfinite(pnLen), "membrane boundary: motion plane normal is not finite");
+  for (lid_t n = 0; n < nN; ++n) {
+    hk(n) = static_cast<int>(pnLen > 0 ? MembraneNodeConstraint::Plane : MembraneNodeConstraint::Free);
+    for (int k = 0; k < 3; ++k) hd(n, k) = pnLen > 0 ? pn[k] / pnLen : 0.0;
+  }
   const auto& normals = mesh_.hostNodeNormals();
   for (lid_t n : boundary_.normalNodes) {
     MFSI_CHECK(n >= 0 && n < nN, "membrane boundary: normal-constrained node " << n << " out of range");
@@ -316,11 +322,13 @@ MembraneSolver::Norms MembraneSolver::norms(const ConstRealView& r) {
   return out;
 }
 
-real MembraneSolver::relativeResidual(const Norms& q, real initialFree) {
+real MembraneSolver::relativeResidual(const Norms& q, real initialFree) const {
   // The reference force: loads, support reactions, and the out-of-balance force the solve started
   // from. The last one matters when the answer carries no force at all (a slack membrane, a rigid
   // motion): loads and reactions then both tend to zero and their ratio to the residual need not.
-  const real scale = std::max({q.external, q.reaction, initialFree});
+  // With tiny loads on a slack membrane (the first steps of an FSI run) every force is far below
+  // the round-off of the internal forces, which then sets the floor (residualFloor).
+  const real scale = std::max({q.external, q.reaction, initialFree, residualFloor() / options_.tolerance});
   return scale > 0 ? q.free / scale : 0.0;
 }
 
@@ -535,7 +543,67 @@ MembraneSolveReport MembraneSolver::lumpedSolve(real time, real loadFactor) {
 // Dynamics
 // ---------------------------------------------------------------------------------------------
 
+MembraneSolver::Integrator MembraneSolver::integrator() const {
+  const auto& dyn = options_.dynamics;
+  Integrator c;
+  c.beta = dyn.beta;
+  c.gamma = dyn.gamma;
+  if (dyn.integrator == MembraneTimeIntegrator::GeneralizedAlpha) {
+    const real rho = dyn.rhoInfinity;
+    c.am = (2 * rho - 1) / (rho + 1);
+    c.af = rho / (rho + 1);
+    c.gamma = 0.5 - c.am + c.af;
+    c.beta = 0.25 * (1 - c.am + c.af) * (1 - c.am + c.af);
+  }
+  return c;
+}
+
+void MembraneSolver::trialKinematics() {
+  // a1 = (u1 - un - dt vn)/(beta dt^2) - (1/(2 beta) - 1) an ;  v1 = vn + dt((1-gamma) an + gamma a1)
+  const Integrator c = integrator();
+  const real beta = c.beta, gamma = c.gamma, dt = trial_.dt;
+  auto u1 = uTrial_;
+  auto un = u_;
+  auto vn = v_;
+  auto an = a_;
+  auto A1 = a1_;
+  auto V1 = v1_;
+  Kokkos::parallel_for(
+      "mfsi::structure::membrane::newmarkKinematics", RangePolicy(exec_, 0, 3 * mesh_.nNodes()),
+      KOKKOS_LAMBDA(lid_t i) {
+        const real acc = (u1(i) - un(i) - dt * vn(i)) / (beta * dt * dt) - (0.5 / beta - 1) * an(i);
+        A1(i) = acc;
+        V1(i) = vn(i) + dt * ((1 - gamma) * an(i) + gamma * acc);
+      });
+}
+
+void MembraneSolver::setTrialDisplacement(const ConstRealView& u1) {
+  MFSI_CHECK(trial_.valid, "membrane: setTrialDisplacement before solveStep");
+  MFSI_CHECK(static_cast<lid_t>(u1.extent(0)) == 3 * mesh_.nNodes(),
+             "membrane: setTrialDisplacement got " << u1.extent(0) << " values for " << 3 * mesh_.nNodes());
+  if (u1.data() != uTrial_.data()) Kokkos::deep_copy(exec_, uTrial_, u1);
+  trialKinematics();
+}
+
+void MembraneSolver::commitStep() {
+  MFSI_CHECK(trial_.valid, "membrane: commitStep without a solved step");
+  Kokkos::deep_copy(exec_, u_, uTrial_);
+  Kokkos::deep_copy(exec_, v_, v1_);
+  Kokkos::deep_copy(exec_, a_, a1_);
+  time_ += trial_.dt;
+  trial_ = {};
+  exec_.fence();
+}
+
+void MembraneSolver::discardStep() { trial_ = {}; }
+
 MembraneSolveReport MembraneSolver::step(real dt) {
+  const MembraneSolveReport rep = solveStep(dt);
+  if (rep.converged) commitStep();
+  return rep;
+}
+
+MembraneSolveReport MembraneSolver::solveStep(real dt) {
   ScopedRegion region("mfsi::structure::membrane::step");
   MFSI_CHECK(dt > 0, "membrane step: dt must be > 0");
   MFSI_CHECK(options_.material.density > 0, "membrane dynamics needs density > 0");
@@ -543,14 +611,12 @@ MembraneSolveReport MembraneSolver::step(real dt) {
   const auto& dyn = options_.dynamics;
   const lid_t n3 = 3 * mesh_.nNodes();
   const bool lumpedMass = dyn.mass == MembraneMassType::Lumped;
-  real am = 0, af = 0, beta = dyn.beta, gamma = dyn.gamma;
-  if (dyn.integrator == MembraneTimeIntegrator::GeneralizedAlpha) {
-    const real rho = dyn.rhoInfinity;
-    am = (2 * rho - 1) / (rho + 1);
-    af = rho / (rho + 1);
-    gamma = 0.5 - am + af;
-    beta = 0.25 * (1 - am + af) * (1 - am + af);
-  }
+  const Integrator ic = integrator();
+  const real am = ic.am, af = ic.af, beta = ic.beta, gamma = ic.gamma;
+  // A second solve of the same step (an FSI iteration) starts from the last trial state.
+  const bool warm = trial_.valid && trial_.dt == dt;
+  trial_.valid = true;
+  trial_.dt = dt;
   if (!haveMass_) {
     if (lumpedMass) {
       lumpedMass_ = RealView("mfsi::structure::membrane::lumpedMass", n3);
@@ -612,31 +678,19 @@ MembraneSolveReport MembraneSolver::step(real dt) {
   }
 
   const real t1 = time_ + dt;
-  // Predictor with a_{n+1} = 0, then the clamps at t_{n+1}.
-  Kokkos::deep_copy(exec_, uTrial_, u_);
-  blas::axpy(exec_, n3, dt, v_, uTrial_);
-  blas::axpy(exec_, n3, (0.5 - beta) * dt * dt, a_, uTrial_);
+  // Predictor with a_{n+1} = 0 (or the last trial of this step), then the clamps at t_{n+1}.
+  if (!warm) {
+    Kokkos::deep_copy(exec_, uTrial_, u_);
+    blas::axpy(exec_, n3, dt, v_, uTrial_);
+    blas::axpy(exec_, n3, (0.5 - beta) * dt * dt, a_, uTrial_);
+  }
   clampTargets(t1);
   Kokkos::deep_copy(exec_, clampStart_, clampTarget_);
   applyClamps(uTrial_, 1);
 
   const RealView a1 = a1_, v1 = v1_, rhs = rhs_;
   const real cM = (1 - am) / (beta * dt * dt), cC = (1 - af) * gamma / (beta * dt);
-  auto kinematics = [&]() {
-    // a1 = (u1 - un - dt vn)/(beta dt^2) - (1/(2 beta) - 1) an ;  v1 = vn + dt((1-gamma) an + gamma a1)
-    auto u1 = uTrial_;
-    auto un = u_;
-    auto vn = v_;
-    auto an = a_;
-    auto A1 = a1;
-    auto V1 = v1;
-    Kokkos::parallel_for(
-        "mfsi::structure::membrane::newmarkKinematics", RangePolicy(exec_, 0, n3), KOKKOS_LAMBDA(lid_t i) {
-          const real acc = (u1(i) - un(i) - dt * vn(i)) / (beta * dt * dt) - (0.5 / beta - 1) * an(i);
-          A1(i) = acc;
-          V1(i) = vn(i) + dt * ((1 - gamma) * an(i) + gamma * acc);
-        });
-  };
+  auto kinematics = [&]() { trialKinematics(); };
   const auto& nopt = options_.newton;
   real rel = 1;
   for (int it = 0; it < nopt.maxIterations; ++it) {
@@ -656,7 +710,7 @@ MembraneSolveReport MembraneSolver::step(real dt) {
       blas::axpy(exec_, n3, -1.0, dampingForce_, rhs);
     }
     const Norms nrm = norms(rhs);
-    const real scale = std::max({nrm.external, nrm.reaction, inertia});
+    const real scale = std::max({nrm.external, nrm.reaction, inertia, residualFloor() / options_.tolerance});
     rel = scale > 0 ? nrm.free / scale : (nrm.free > 0 ? 1.0 : 0.0);
     rep.relativeResidual = rel;
     if (rel <= options_.tolerance) {
@@ -693,12 +747,7 @@ MembraneSolveReport MembraneSolver::step(real dt) {
     blas::axpy(exec_, n3, 1.0, du_, uTrial_);
     ++rep.iterations;
   }
-  if (rep.converged) {
-    Kokkos::deep_copy(exec_, u_, uTrial_);
-    Kokkos::deep_copy(exec_, v_, v1);
-    Kokkos::deep_copy(exec_, a_, a1);
-    time_ = t1;
-  }
+  if (!rep.converged) kinematics();  // the trial velocity matches the trial displacement
   exec_.fence();
   rep.seconds = wallSeconds() - wall0;
   last_ = rep;

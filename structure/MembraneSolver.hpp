@@ -66,8 +66,25 @@ class MembraneSolver {
   MembraneSolveReport solveStatic(real time = 0);
 
   /// \brief One implicit time step of size dt from the current state (Newton with the
-  /// consistent tangent, whatever `options().solver`: the mass term keeps the matrix definite).
+  /// consistent tangent, whatever `options().solver`: the mass term keeps the matrix definite):
+  /// `solveStep`, then `commitStep` when it converged.
   MembraneSolveReport step(real dt);
+
+  // --- one step solved several times (FSI iterations) ----------------------------------------
+  /// \brief Solve the step of size dt from the committed state (time(), displacement(),
+  /// velocity(), acceleration(), all left unchanged) on the current loads. A repeated call for the
+  /// same dt starts Newton from the last trial state. The result is the trial state.
+  MembraneSolveReport solveStep(real dt);
+  /// Trial state at time() + dt of the last `solveStep` (3 per node).
+  RealView trialDisplacement() const { return uTrial_; }
+  RealView trialVelocity() const { return v1_; }
+  /// \brief Replace the trial displacement (a relaxed FSI update); the trial velocity and
+  /// acceleration follow from the integrator's relations.
+  void setTrialDisplacement(const ConstRealView& u1);
+  /// \brief The trial state becomes the state at time() + dt.
+  void commitStep();
+  /// \brief Forget the trial state (the next solveStep starts from the predictor).
+  void discardStep();
 
   real time() const { return time_; }
   void setTime(real t) { time_ = t; }
@@ -76,7 +93,10 @@ class MembraneSolver {
   RealView velocity() const { return v_; }
   RealView acceleration() const { return a_; }
   /// Forget the stored acceleration; the next `step` recomputes it from M a = R - C v.
-  void resetDynamics() { haveAcceleration_ = false; }
+  void resetDynamics() {
+    haveAcceleration_ = false;
+    trial_ = {};
+  }
 
   /// \brief Results at the current state.
   MembraneResults results();
@@ -118,7 +138,20 @@ class MembraneSolver {
   void clampTargets(real time);
   void applyClamps(const RealView& u, real weight);
   Norms norms(const ConstRealView& r);
-  static real relativeResidual(const Norms& q, real initialFree);
+  /// |free residual| / max(loads, reactions, initialFree, residualFloor / tolerance).
+  real relativeResidual(const Norms& q, real initialFree) const;
+  /// Round-off level of the internal nodal forces, 1e-13 E h lchar [N]: a residual below it is
+  /// converged whatever the loads (a slack membrane under a vanishing load).
+  real residualFloor() const {
+    return 1e-13 * options_.material.youngsModulus * options_.material.thickness * lchar_;
+  }
+  /// Newmark / generalized-alpha coefficients of the options.
+  struct Integrator {
+    real am = 0, af = 0, beta = 0.25, gamma = 0.5;
+  };
+  Integrator integrator() const;
+  /// a1_, v1_ from uTrial_ and the committed state.
+  void trialKinematics();
   real maxNodalNorm(const ConstRealView& d);
 
   MembraneSolveReport newtonSolve(real time, real loadFactor);
@@ -144,6 +177,12 @@ class MembraneSolver {
   bool haveAcceleration_ = false;
   bool haveMass_ = false;
   MembraneSolveReport last_;
+  /// The trial state of solveStep: whether it holds one, and its step size.
+  struct Trial {
+    bool valid = false;
+    real dt = 0;
+  };
+  Trial trial_;
 
   ItemValuesView itemVec_, itemExt_, itemMat_;
   RealView u_, v_, a_, R_, Fext_, du_, uTrial_, work_, work2_, rn_, lumpedMass_, pNode_, offsetSign_;

@@ -82,6 +82,9 @@ class Acceleration {
   AccelerationReport update(const InterfaceVector& xt, InterfaceVector& x);
   /// \brief The step's iterations are over (converged or not).
   virtual void endStep() {}
+  /// \brief Forget what was learnt in this step (the next update is a first one): the caller
+  /// replaced the iterate the last update asked for (e.g. the mesh could not follow it).
+  void resetHistory() { restart(); }
 
   const AccelerationOptions& options() const { return options_; }
   const std::vector<InterfaceBlock>& layout() const { return layout_; }

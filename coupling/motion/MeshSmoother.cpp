@@ -2,7 +2,10 @@
 
 #include "core/Error.hpp"
 
+#include <array>
+#include <cmath>
 #include <sstream>
+#include <vector>
 
 namespace mfsi::coupling {
 
@@ -10,16 +13,74 @@ namespace {
 
 // The constructor's kernels are free functions: nvcc takes no device lambda in a constructor.
 
-/// fixed(i) = 1 for every node of a boundary face. Several faces may mark one node: every writer
-/// stores the same 1, so the race is benign.
-Kokkos::View<std::uint8_t*, MemSpace> boundaryNodes(const HexMesh& mesh) {
-  Kokkos::View<std::uint8_t*, MemSpace> fixed("mfsi::coupling::motion::prescribed", mesh.nNodes());
-  const ConstQuad4View fn = mesh.faceNodes();
-  Kokkos::parallel_for(
-      "mfsi::coupling::motion::markBoundaryNodes", RangePolicy(ExecSpace(), mesh.nInternalFaces(), mesh.nFaces()),
-      KOKKOS_LAMBDA(lid_t f) {
-        for (int k = 0; k < 4; ++k) fixed(fn(f, k)) = 1;
-      });
+/// Which nodes the smoother may move. fixed(i) = 1 for every node of a boundary face, except
+/// faces of empty patches (the front and back of a one-cell-thick 2D mesh: their nodes follow the
+/// in-plane motion; a displacement with no out-of-plane part prescribed anywhere keeps none after
+/// smoothing, exactly) and faces of sliding patches: a node all of whose other boundary faces are
+/// on sliding patches and share one plane slides in that plane (normal in `slide`), a node where
+/// sliding planes meet at an angle or a non-sliding face touches is fixed. Built on the host once.
+Kokkos::View<std::uint8_t*, MemSpace> boundaryNodes(const HexMesh& mesh, const std::vector<std::string>& sliding,
+                                                  Real3View& slide) {
+  const lid_t nn = mesh.nNodes();
+  const int np = static_cast<int>(mesh.patches().size());
+  std::vector<int> role(np, 1);  // 0: empty, 1: prescribes, 2: slides
+  for (int p = 0; p < np; ++p) {
+    const Patch& pt = mesh.patches()[p];
+    if (pt.kind == PatchKind::Empty) role[p] = 0;
+    for (const auto& s : sliding)
+      if (s == pt.name) role[p] = 2;
+  }
+  for (const auto& s : sliding)
+    MFSI_CHECK(mesh.findPatch(s) >= 0, "mesh motion: no patch '" << s << "' to slide along");
+  auto fn = Kokkos::create_mirror_view_and_copy(HostSpace(), mesh.faceNodes());
+  auto fp = Kokkos::create_mirror_view_and_copy(HostSpace(), mesh.facePatch());
+  auto x = Kokkos::create_mirror_view_and_copy(HostSpace(), mesh.referencePoints());
+  std::vector<std::uint8_t> fixedH(nn, 0), hasSlide(nn, 0);
+  std::vector<std::array<double, 3>> normal(nn, {0, 0, 0});
+  for (lid_t f = mesh.nInternalFaces(); f < mesh.nFaces(); ++f) {
+    const int r = fp(f) < 0 ? 1 : role[fp(f)];
+    if (r == 0) continue;
+    if (r == 1) {
+      for (int k = 0; k < 4; ++k) fixedH[fn(f, k)] = 1;
+      continue;
+    }
+    // Unit normal of the face from its diagonals.
+    double d1[3], d2[3], n[3];
+    for (int c = 0; c < 3; ++c) {
+      d1[c] = x(fn(f, 2), c) - x(fn(f, 0), c);
+      d2[c] = x(fn(f, 3), c) - x(fn(f, 1), c);
+    }
+    n[0] = d1[1] * d2[2] - d1[2] * d2[1];
+    n[1] = d1[2] * d2[0] - d1[0] * d2[2];
+    n[2] = d1[0] * d2[1] - d1[1] * d2[0];
+    const double len = std::sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
+    for (int k = 0; k < 4; ++k) {
+      const lid_t v = fn(f, k);
+      if (!hasSlide[v]) {
+        for (int c = 0; c < 3; ++c) normal[v][c] = n[c] / len;
+        hasSlide[v] = 1;
+      } else {
+        const double dot = normal[v][0] * n[0] / len + normal[v][1] * n[1] / len + normal[v][2] * n[2] / len;
+        if (std::abs(dot) < 1 - 1e-9) fixedH[v] = 1;  // a corner of sliding planes
+      }
+    }
+  }
+  Kokkos::View<std::uint8_t*, MemSpace> fixed("mfsi::coupling::motion::prescribed", nn);
+  auto hf = Kokkos::create_mirror_view(fixed);
+  bool any = false;
+  for (lid_t i = 0; i < nn; ++i) {
+    hf(i) = fixedH[i];
+    any = any || (hasSlide[i] && !fixedH[i]);
+  }
+  Kokkos::deep_copy(fixed, hf);
+  slide = Real3View();
+  if (any) {
+    slide = Real3View("mfsi::coupling::motion::slideNormal", nn);
+    auto hs = Kokkos::create_mirror_view(slide);
+    for (lid_t i = 0; i < nn; ++i)
+      for (int c = 0; c < 3; ++c) hs(i, c) = hasSlide[i] && !fixedH[i] ? normal[i][c] : 0.0;
+    Kokkos::deep_copy(slide, hs);
+  }
   return fixed;
 }
 
@@ -46,8 +107,8 @@ MeshSmoother::MeshSmoother(const HexMesh& mesh, const MeshSmootherOptions& optio
   MFSI_CHECK(options_.sweeps >= 0, "mesh motion: sweeps must be >= 0, got " << options_.sweeps);
   MFSI_CHECK(options_.retries >= 0, "mesh motion: retries must be >= 0, got " << options_.retries);
   const lid_t nn = mesh.nNodes();
-  fixed_ = boundaryNodes(mesh);
-  graph_ = SmoothingGraph{mesh.nodeNodeOffsets(), mesh.nodeNodes(), fixed_, {}};
+  fixed_ = boundaryNodes(mesh, options_.slidingPatches, slide_);
+  graph_ = SmoothingGraph{mesh.nodeNodeOffsets(), mesh.nodeNodes(), fixed_, {}, slide_};
   stiff_ = graph_;
   stiff_.weights = inverseSquareEdgeWeights(mesh);
   d_ = Real3View("mfsi::coupling::motion::displacement", nn);
@@ -70,16 +131,28 @@ MotionReport MeshSmoother::move(const ExecSpace& exec, MeshGeometry& geo) {
   ScopedRegion region("mfsi::coupling::motion");
   Kokkos::deep_copy(exec, start_, d_);  // prescribed values + the warm start
   MotionReport rep;
-  for (int attempt = 0; attempt <= options_.retries; ++attempt) {
-    const bool stiff = attempt > 0 && attempt == options_.retries;
-    const int sweeps = stiff ? options_.sweeps << (attempt - 1) : options_.sweeps << attempt;
-    if (attempt > 0) Kokkos::deep_copy(exec, d_, start_);
-    jacobiSmooth(exec, stiff ? stiff_ : graph_, d_, work_, sweeps);
+  auto measure = [&](int sweeps, int attempt, bool stiff) {
     place(exec, d_);
     computeGeometry(exec, mesh_, geo);
-    const MeshQuality q = computeQuality(exec, mesh_, geo);
-    rep = MotionReport{sweeps, attempt, stiff, q.minScaledJacobian};
-    if (q.minScaledJacobian >= options_.minScaledJacobian) break;
+    rep = MotionReport{sweeps, attempt, stiff, computeQuality(exec, mesh_, geo).minScaledJacobian};
+  };
+  if (options_.method == MeshMotionMethod::ConjugateGradient) {
+    // Solved once, on the 1/L^2-weighted graph: on a graded mesh the plain graph Laplacian is
+    // harmonic in index space and crushes the thin cells, the weighted one approximates the
+    // Laplacian of the geometry. A converged solve gains nothing from a retry.
+    LaplacianCgOptions o;
+    o.relTol = options_.relTol;
+    o.maxIterations = options_.maxIterations;
+    measure(laplacianCg(exec, stiff_, d_, cg_, o).iterations, 0, true);
+  } else {
+    for (int attempt = 0; attempt <= options_.retries; ++attempt) {
+      const bool stiff = attempt > 0 && attempt == options_.retries;
+      const int sweeps = stiff ? options_.sweeps << (attempt - 1) : options_.sweeps << attempt;
+      if (attempt > 0) Kokkos::deep_copy(exec, d_, start_);
+      jacobiSmooth(exec, stiff ? stiff_ : graph_, d_, work_, sweeps);
+      measure(sweeps, attempt, stiff);
+      if (rep.minScaledJacobian >= options_.minScaledJacobian) break;
+    }
   }
   if (!(rep.minScaledJacobian > 0)) {
     Kokkos::deep_copy(exec, d_, good_);

@@ -11,10 +11,21 @@
 /// bit-identical (zero stays exactly zero), and a warm start needs few sweeps per FSI iteration.
 #include "core/MeshGeometry.hpp"
 #include "kernels/JacobiSmoothing.hpp"
+#include "kernels/LaplacianCg.hpp"
 
 #include <cstdint>
+#include <string>
+#include <vector>
 
 namespace mfsi::coupling {
+
+/// How the point-Laplacian of the displacement is treated.
+enum class MeshMotionMethod {
+  Jacobi,             ///< `sweeps` Jacobi sweeps from the last displacement (the seed's smoother)
+  /// Solved to `relTol` by Jacobi-preconditioned CG from the last displacement, with the edge
+  /// weights 1 / L^2 of the stiffened smoother (no retries: a solved field is what it is).
+  ConjugateGradient,
+};
 
 struct MeshSmootherOptions {
   int sweeps = 50;  ///< Jacobi sweeps per motion
@@ -24,11 +35,17 @@ struct MeshSmootherOptions {
   /// Retries: the first ones double the sweeps each time; the last uses the stiffened smoother,
   /// whose edge weights 1 / L^2 (L the reference edge length) make small cells move more rigidly.
   int retries = 3;
+  MeshMotionMethod method = MeshMotionMethod::Jacobi;
+  double relTol = 1e-8;      ///< CG: residual reduction per motion
+  int maxIterations = 2000;  ///< CG: iterations per motion
+  /// Patches whose nodes slide along them (in the plane of the patch where it is flat) instead of
+  /// staying put: walls next to a deflecting membrane, so the corner cells shear less.
+  std::vector<std::string> slidingPatches;
 };
 
 /// \brief What one `move` did.
 struct MotionReport {
-  int sweeps = 0;  ///< sweeps of the accepted motion
+  int sweeps = 0;  ///< sweeps (Jacobi) or iterations (CG) of the accepted motion
   int retries = 0;
   bool stiffened = false;
   double minScaledJacobian = 0;
@@ -36,8 +53,9 @@ struct MotionReport {
 
 class MeshSmoother {
  public:
-  /// Every node of a boundary face (walls, inlets, baffle sides, ...) is prescribed; the others
-  /// are smoothed. The mesh must outlive the smoother; `move` moves its points.
+  /// Every node of a boundary face (walls, inlets, baffle sides, ...) is prescribed, except on
+  /// empty patches (2D front and back) and sliding patches (nodes slide in the patch plane); the
+  /// others are smoothed. Throws InputError for an unknown sliding patch. The mesh must outlive the smoother; `move` moves its points.
   MeshSmoother(const HexMesh& mesh, const MeshSmootherOptions& options);
 
   /// Displacement of every node from the reference mesh [m]: set the prescribed (boundary) entries
@@ -60,6 +78,8 @@ class MeshSmoother {
   Kokkos::View<std::uint8_t*, MemSpace> fixed_;
   SmoothingGraph graph_, stiff_;
   Real3View d_, work_, start_, good_;
+  Real3View slide_;  ///< unit normal of sliding nodes (zero elsewhere); empty without sliding patches
+  LaplacianCgWork cg_;
 };
 
 }  // namespace mfsi::coupling

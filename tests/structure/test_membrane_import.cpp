@@ -94,7 +94,7 @@ double expectSameSolution(const MembraneMesh& a, const std::vector<lid_t>& clamp
 
 TEST(MembraneImport, BaffleGivesMasterQuadsAndFluidNodeMap) {
   const HexMesh fluid = boxWithSail();
-  const BaffleMembraneInput in = membraneMeshFromBaffle(fluid, "sail");
+  const FluidSurfaceMembraneInput in = membraneMeshFromBaffle(fluid, "sail");
   const MembraneMesh mesh = buildMembraneMesh(in.mesh);
   EXPECT_EQ(mesh.nElements(), 16);
   EXPECT_EQ(mesh.nQuads(), 16);

@@ -1,0 +1,106 @@
+#include "coupling/interface/MembraneInterface.hpp"
+
+#include "core/Error.hpp"
+
+namespace mfsi::coupling {
+
+namespace {
+IndexView toDevice(const std::vector<lid_t>& v, const std::string& label, lid_t shift) {
+  IndexView d(label, v.size());
+  auto h = Kokkos::create_mirror_view(d);
+  for (std::size_t i = 0; i < v.size(); ++i) h(i) = v[i] - shift;
+  Kokkos::deep_copy(d, h);
+  return d;
+}
+}  // namespace
+
+MembraneInterface makeMembraneInterface(const HexMesh& mesh, const FluidSurfaceMembraneInput& surface,
+                                        const std::string& name, InterfaceSide side) {
+  MFSI_CHECK(side == InterfaceSide::Patch || surface.slaveFace.size() == surface.masterFace.size(),
+             "coupling: baffle interface '" << name << "' needs one slave face per master face");
+  const lid_t nIn = mesh.nInternalFaces();
+  for (lid_t f : surface.masterFace)
+    MFSI_CHECK(f >= nIn && f < mesh.nFaces(), "coupling: interface face " << f << " is not a boundary face");
+  MembraneInterface m;
+  m.surface = name;
+  m.side = side;
+  m.fluidNode = toDevice(surface.fluidNode, "mfsi::coupling::interface::fluidNode", 0);
+  m.front = toDevice(surface.masterFace, "mfsi::coupling::interface::front", nIn);
+  m.back = side == InterfaceSide::Baffle ? toDevice(surface.slaveFace, "mfsi::coupling::interface::back", nIn)
+                                         : IndexView("mfsi::coupling::interface::back", 0);
+  return m;
+}
+
+void interfacePressure(const ExecSpace& exec, const MembraneInterface& iface, const ConstRealView& pb, real outside,
+                       real scale, real pClamp, const RealView& elementPressure) {
+  const ConstIndexView front = iface.front, back = iface.back;
+  const bool baffle = iface.side == InterfaceSide::Baffle;
+  Kokkos::parallel_for(
+      "mfsi::coupling::interface::pressure", RangePolicy(exec, 0, iface.nElements()), KOKKOS_LAMBDA(lid_t e) {
+        real p = scale * (pb(front(e)) - (baffle ? pb(back(e)) : outside));
+        if (pClamp > 0) p = p > pClamp ? pClamp : (p < -pClamp ? -pClamp : p);
+        elementPressure(e) = p;
+      });
+}
+
+std::array<double, 3> interfaceForce(const ExecSpace& exec, const MembraneInterface& iface, lid_t nInternalFaces,
+                                     const ConstReal3View& faceArea, const ConstRealView& elementPressure) {
+  const ConstIndexView front = iface.front;
+  std::array<double, 3> F{0, 0, 0};
+  for (int k = 0; k < 3; ++k) {
+    double s = 0;
+    Kokkos::parallel_reduce(
+        "mfsi::coupling::interface::force", RangePolicy(exec, 0, iface.nElements()),
+        KOKKOS_LAMBDA(lid_t e, double& acc) { acc += elementPressure(e) * faceArea(front(e) + nInternalFaces, k); },
+        s);
+    F[k] = s;
+  }
+  return F;
+}
+
+void interfaceViscousForce(const ExecSpace& exec, const MembraneInterface& iface, const NodeItemMap& nodeElements,
+                           lid_t nInternalFaces, const ConstRealView& faceAreaMag, const ConstReal3View& tvFront,
+                           const ConstReal3View& tvBack, real scale, const Real3View& nodeForce) {
+  const ConstIndexView front = iface.front, back = iface.back, off = nodeElements.offsets,
+                       entries = nodeElements.entries;
+  const bool baffle = iface.side == InterfaceSide::Baffle;
+  const lid_t nIn = nInternalFaces;
+  Kokkos::parallel_for(
+      "mfsi::coupling::interface::viscousForce", RangePolicy(exec, 0, iface.nNodes()), KOKKOS_LAMBDA(lid_t n) {
+        real f[3] = {0, 0, 0};
+        for (lid_t k = off(n); k < off(n + 1); ++k) {
+          const lid_t e = entries(k) / kMaxItemNodes;
+          const real af = 0.25 * scale * faceAreaMag(front(e) + nIn);
+          const real ab = baffle ? 0.25 * scale * faceAreaMag(back(e) + nIn) : real(0);
+          for (int c = 0; c < 3; ++c) f[c] += af * tvFront(e, c) + (baffle ? ab * tvBack(e, c) : real(0));
+        }
+        for (int c = 0; c < 3; ++c) nodeForce(n, c) = f[c];
+      });
+}
+
+void interfaceDisplacement(const ExecSpace& exec, const MembraneInterface& iface, const ConstRealView& u,
+                           const Real3View& meshDisplacement) {
+  const ConstIndexView node = iface.fluidNode;
+  Kokkos::parallel_for(
+      "mfsi::coupling::interface::displacement", RangePolicy(exec, 0, iface.nNodes()), KOKKOS_LAMBDA(lid_t i) {
+        for (int k = 0; k < 3; ++k) meshDisplacement(node(i), k) = u(3 * i + k);
+      });
+}
+
+void interfaceFaceVelocity(const ExecSpace& exec, const MembraneInterface& iface, const ConstQuad4View& elements,
+                           const ConstRealView& v, const Real3View& faceVelocity) {
+  Kokkos::parallel_for(
+      "mfsi::coupling::interface::faceVelocity", RangePolicy(exec, 0, iface.nElements()), KOKKOS_LAMBDA(lid_t e) {
+        int n = 0;
+        real s[3] = {0, 0, 0};
+        for (int a = 0; a < 4; ++a) {
+          const lid_t node = elements(e, a);
+          if (node < 0) continue;
+          ++n;
+          for (int k = 0; k < 3; ++k) s[k] += v(3 * node + k);
+        }
+        for (int k = 0; k < 3; ++k) faceVelocity(e, k) = s[k] / n;
+      });
+}
+
+}  // namespace mfsi::coupling

@@ -1,0 +1,139 @@
+#include "coupling/orchestrator/CouplingConfig.hpp"
+
+namespace mfsi {
+
+Schema couplingSchema() {
+  const CouplingOptions o;
+  const coupling::AccelerationOptions& a = o.acceleration;
+  Schema motion =
+      Schema::map("interior mesh motion: the point-Laplacian of the boundary displacement, swept or solved")
+          .key("method",
+               Schema::choice("cg: solved by conjugate gradients to relTol (the default: Jacobi sweeps spread a "
+                              "wall motion by ~sqrt(sweeps) cells only); jacobi: `sweeps` Jacobi sweeps per motion "
+                              "(the seed's smoother)",
+                              {"cg", "jacobi"}),
+               Default("cg"))
+          .key("sweeps", Schema::integer("jacobi: sweeps per motion").atLeast(0), Default(o.motion.sweeps))
+          .key("relTol", Schema::real("cg: residual reduction per motion", "-").greaterThan(0).lessThan(1),
+               Default(o.motion.relTol))
+          .key("maxIterations", Schema::integer("cg: iterations per motion").atLeast(1),
+               Default(o.motion.maxIterations))
+          .key("minScaledJacobian",
+               Schema::real("quality guard: below this the motion is retried (more sweeps, then the stiffened "
+                            "smoother); an inverted cell stops the run",
+                            "-")
+                   .atLeast(0)
+                   .atMost(1),
+               Default(o.motion.minScaledJacobian))
+          .key("retries", Schema::integer("jacobi: retries of the quality guard").atLeast(0), Default(o.motion.retries))
+          .key("slidingPatches",
+               Schema::list("patches whose nodes slide along them (flat walls next to a membrane)",
+                            Schema::string("patch name")),
+               Presence::Optional);
+  return Schema::map("two-way fluid-structure coupling of the fluid and the membranes cut from its mesh")
+      .key("scheme",
+           Schema::choice("implicit: Gauss-Seidel iterations per step (structure first) to fsiTol; explicit: one "
+                          "staggered pass per step",
+                          {"implicit", "explicit"}),
+           Default("implicit"))
+      .key("convergence",
+           Schema::choice("residuals that must fall below fsiTol: displacement, or both (and the load change)",
+                          {"displacement", "both"}),
+           Default("both"))
+      .key("fsiTol", Schema::real("relative interface residual tolerance", "-").greaterThan(0), Default(o.fsiTol))
+      .key("minFsiIter", Schema::integer("fluid solves per step, at least").atLeast(1), Default(o.minFsiIter))
+      .key("maxFsiIter", Schema::integer("fluid solves per step, at most").atLeast(1), Default(o.maxFsiIter))
+      .key("maxUnconvergedSteps",
+           Schema::integer("steps in a row that may end at maxFsiIter before the run stops as diverged").atLeast(1),
+           Default(o.maxUnconvergedSteps))
+      .key("relaxation",
+           Schema::choice("displacement relaxation when iqnMaxCols = 0: aitken (Delta^2) or constant (omegaInit)",
+                          {"aitken", "constant"}),
+           Default("aitken"))
+      .key("omegaInit", Schema::real("first relaxation factor of a step (constant: every iteration)", "-")
+                            .greaterThan(0)
+                            .atMost(1),
+           Default(a.omegaInit))
+      .key("omegaMin", Schema::real("Aitken's lower bound on omega", "-").greaterThan(0).atMost(1),
+           Default(a.omegaMin))
+      .key("iqnMaxCols", Schema::integer("IQN-ILS history columns (> 0 selects IQN-ILS)").atLeast(0),
+           Default(a.iqnMaxCols))
+      .key("iqnReuseCols", Schema::integer("past time steps whose IQN-ILS columns are reused").atLeast(0),
+           Default(a.iqnReuseCols))
+      .key("iqnFilter",
+           Schema::real("QR2 filter: drop a column whose new part is below this fraction of its norm", "-")
+               .atLeast(0)
+               .lessThan(1),
+           Default(a.iqnFilterEps))
+      .key("iqnMaxUpdate",
+           Schema::real("step-size limiter: a quasi-Newton update larger than this falls back to Aitken (0: off)",
+                        "m")
+               .atLeast(0),
+           Default(a.maxUpdate))
+      .key("stallIterations",
+           Schema::integer("restart the history after this many iterations without a new smallest residual (0: off)")
+               .atLeast(0),
+           Default(a.stallIterations))
+      .key("forceOmega", Schema::real("under-relaxation of the membrane load between iterations", "-")
+                             .greaterThan(0)
+                             .atMost(1),
+           Default(o.forceOmega))
+      .key("fsiStartTime", Schema::real("structure frozen (mesh fixed) before this time", "s").atLeast(0),
+           Default(o.fsiStartTime))
+      .key("fsiRampTime", Schema::real("load ramp 0 -> 100 % after fsiStartTime (0: none)", "s").atLeast(0),
+           Default(o.fsiRampTime))
+      .key("pClamp", Schema::real("limit on |pNet| of the membrane load (0: none)", "Pa").atLeast(0),
+           Default(o.pClamp))
+      .key("outsidePressure",
+           Schema::real("pressure behind a membrane that replaces a boundary patch (its load is p - this)", "Pa"),
+           Default(o.outsidePressure))
+      .key("viscousTraction",
+           Schema::boolean("load the membranes with the fluid's viscous traction too (nodal forces), not the "
+                           "pressure alone"),
+           Default(o.viscousTraction))
+      .key("meshMotion", motion, Presence::Optional);
+}
+
+CouplingOptions readCouplingOptions(const SceneConfig& c) {
+  CouplingOptions o;
+  o.scheme = c.get<std::string>("scheme") == "explicit" ? CouplingScheme::Explicit : CouplingScheme::Implicit;
+  o.convergence = c.get<std::string>("convergence") == "displacement" ? CouplingConvergence::Displacement
+                                                                     : CouplingConvergence::Both;
+  o.fsiTol = c.get<double>("fsiTol");
+  o.minFsiIter = c.get<int>("minFsiIter");
+  o.maxFsiIter = c.get<int>("maxFsiIter");
+  if (o.minFsiIter > o.maxFsiIter)
+    throw InputError(c.where("minFsiIter"), "minFsiIter (" + std::to_string(o.minFsiIter) + ") exceeds maxFsiIter (" +
+                                                std::to_string(o.maxFsiIter) + ")");
+  o.maxUnconvergedSteps = c.get<int>("maxUnconvergedSteps");
+  coupling::AccelerationOptions& a = o.acceleration;
+  a.omegaInit = c.get<double>("omegaInit");
+  a.omegaMin = c.get<double>("omegaMin");
+  a.iqnMaxCols = c.get<int>("iqnMaxCols");
+  a.iqnReuseCols = c.get<int>("iqnReuseCols");
+  a.iqnFilterEps = c.get<double>("iqnFilter");
+  a.maxUpdate = c.get<double>("iqnMaxUpdate");
+  a.stallIterations = c.get<int>("stallIterations");
+  a.method = a.iqnMaxCols > 0                                    ? coupling::AccelerationMethod::IqnIls
+             : c.get<std::string>("relaxation") == "constant" ? coupling::AccelerationMethod::Constant
+                                                              : coupling::AccelerationMethod::Aitken;
+  if (a.omegaMin > a.omegaInit && a.method == coupling::AccelerationMethod::Aitken)
+    throw InputError(c.where("omegaMin"), "omegaMin exceeds omegaInit");
+  o.forceOmega = c.get<double>("forceOmega");
+  o.fsiStartTime = c.get<double>("fsiStartTime");
+  o.fsiRampTime = c.get<double>("fsiRampTime");
+  o.pClamp = c.get<double>("pClamp");
+  o.outsidePressure = c.get<double>("outsidePressure");
+  o.viscousTraction = c.get<bool>("viscousTraction");
+  o.motion.method = c.get<std::string>("meshMotion.method") == "jacobi" ? coupling::MeshMotionMethod::Jacobi
+                                                                        : coupling::MeshMotionMethod::ConjugateGradient;
+  o.motion.sweeps = c.get<int>("meshMotion.sweeps");
+  o.motion.relTol = c.get<double>("meshMotion.relTol");
+  o.motion.maxIterations = c.get<int>("meshMotion.maxIterations");
+  o.motion.minScaledJacobian = c.get<double>("meshMotion.minScaledJacobian");
+  o.motion.retries = c.get<int>("meshMotion.retries");
+  o.motion.slidingPatches = c.get<std::vector<std::string>>("meshMotion.slidingPatches");
+  return o;
+}
+
+}  // namespace mfsi

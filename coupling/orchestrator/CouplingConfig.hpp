@@ -1,0 +1,63 @@
+#pragma once
+/// \file
+/// \brief Config layer of the `coupling` section: its schema (the seed's parameter names) and the
+/// plain options the orchestrator runs with. The orchestrator never sees the scene.
+///
+/// \code{.yaml}
+/// coupling:
+///   scheme: implicit        # implicit (Gauss-Seidel iterations, structure first) | explicit (one pass)
+///   fsiTol: 1.0e-5          # relative interface residuals: max(|dx|/|x|, |df|/|f|)
+///   minFsiIter: 1
+///   maxFsiIter: 30
+///   omegaInit: 0.5          # Aitken's first relaxation of a step
+///   omegaMin: 0.05
+///   iqnMaxCols: 30          # > 0: IQN-ILS instead of Aitken
+///   iqnReuseCols: 0         # past steps whose columns IQN-ILS reuses
+///   forceOmega: 1           # under-relaxation of the membrane load between iterations
+///   fsiStartTime: 0         # structure frozen before this time
+///   fsiRampTime: 0          # load ramp 0 -> 100 % after fsiStartTime
+///   outsidePressure: 0      # pressure behind a membrane that replaces a wall patch
+///   meshMotion: {sweeps: 50, minScaledJacobian: 0.05}
+/// \endcode
+#include "core/SceneConfig.hpp"
+#include "coupling/acceleration/Acceleration.hpp"
+#include "coupling/motion/MeshSmoother.hpp"
+
+namespace mfsi {
+
+/// Implicit: Gauss-Seidel iterations to convergence per step; explicit: one staggered pass.
+enum class CouplingScheme { Implicit, Explicit };
+
+/// Which interface residuals must fall below fsiTol.
+enum class CouplingConvergence {
+  Displacement,  ///< |x~ - x| / |x~| alone
+  Both,          ///< and the load change |f_k - f_{k-1}| / |f_k| (the seed's max of both)
+};
+
+/// \brief Everything the `coupling` section describes.
+struct CouplingOptions {
+  CouplingScheme scheme = CouplingScheme::Implicit;
+  CouplingConvergence convergence = CouplingConvergence::Both;
+  double fsiTol = 1e-5;
+  int minFsiIter = 1;   ///< fluid solves per step, at least
+  int maxFsiIter = 30;  ///< fluid solves per step, at most
+  /// maxFsiIter reached on this many steps in a row stops the run as diverged.
+  int maxUnconvergedSteps = 3;
+  coupling::AccelerationOptions acceleration;
+  double forceOmega = 1;      ///< load under-relaxation between iterations (1: none)
+  double fsiStartTime = 0;    ///< s
+  double fsiRampTime = 0;     ///< s
+  double pClamp = 0;          ///< |pNet| limit [Pa] (0: none)
+  double outsidePressure = 0; ///< Pa
+  bool viscousTraction = false;  ///< add the fluid's viscous traction to the membrane loads
+  coupling::MeshSmootherOptions motion;
+};
+
+/// Schema of the `coupling` section.
+Schema couplingSchema();
+
+/// Options of a view of the `coupling` section. Throws InputError naming the key on semantic
+/// errors (minFsiIter > maxFsiIter).
+CouplingOptions readCouplingOptions(const SceneConfig& coupling);
+
+}  // namespace mfsi

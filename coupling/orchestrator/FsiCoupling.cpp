@@ -1,0 +1,400 @@
+#include "coupling/orchestrator/FsiCoupling.hpp"
+
+#include "core/Error.hpp"
+#include "core/Suggest.hpp"
+#include "fluid/BoundaryConditions.hpp"
+#include "fluid/Loads.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <sstream>
+
+namespace mfsi {
+
+using coupling::InterfaceVector;
+
+namespace {
+
+/// The fluid-mesh surface a membrane was cut from (the same call that built its mesh).
+FluidSurfaceMembraneInput fluidSurfaceOf(const MembranePanelOptions& panel, const HexMesh& mesh) {
+  return panel.mesh.kind == MembraneMeshKind::Baffle ? membraneMeshFromBaffle(mesh, panel.mesh.baffle)
+                                                     : membraneMeshFromPatch(mesh, panel.mesh.patch);
+}
+
+/// Device flat vector -> a slice of a host interface vector, and back.
+void toHost(const ConstRealView& d, InterfaceVector& x, Eigen::Index offset) {
+  auto h = Kokkos::create_mirror_view_and_copy(HostSpace(), d);
+  for (std::size_t i = 0; i < h.extent(0); ++i) x[offset + static_cast<Eigen::Index>(i)] = h(i);
+}
+void toDevice(const InterfaceVector& x, Eigen::Index offset, const RealView& d) {
+  auto h = Kokkos::create_mirror_view(d);
+  for (std::size_t i = 0; i < h.extent(0); ++i) h(i) = x[offset + static_cast<Eigen::Index>(i)];
+  Kokkos::deep_copy(d, h);
+}
+
+}  // namespace
+
+FsiCoupling::FsiCoupling(const CouplingOptions& options, const SceneConfig& section, HexMesh& mesh,
+                         MeshGeometry& geometry, Timers& timers, std::unique_ptr<FluidModule> fluid,
+                         std::vector<std::unique_ptr<MembraneModule>> membranes)
+    : Module("coupling"),
+      options_(options),
+      mesh_(mesh),
+      geometry_(geometry),
+      timers_(timers),
+      fluid_(std::move(fluid)),
+      ownedMembranes_(std::move(membranes)) {
+  MFSI_CHECK(fluid_, "coupling: no fluid module");
+  if (ownedMembranes_.empty())
+    throw InputError(section.where(), "the coupling needs at least one membrane cut from the fluid mesh "
+                                      "(membranes.N.mesh: baffles or boundaryPatch)");
+  const fluid::BoundaryConditions& bc = fluid_->solver().boundaryConditions();
+  std::vector<coupling::InterfaceBlock> layout;
+  for (auto& m : ownedMembranes_) {
+    const MembranePanelOptions& po = m->panel();
+    if (po.mesh.kind != MembraneMeshKind::Baffle && po.mesh.kind != MembraneMeshKind::Patch)
+      throw InputError(section.where(), m->name() + " is not cut from the fluid mesh: give it 'mesh: {baffles: ...}' "
+                                                    "or 'mesh: {boundaryPatch: ...}' to couple it");
+    Panel p;
+    p.module = m.get();
+    const FluidSurfaceMembraneInput surf = fluidSurfaceOf(po, mesh_);
+    const MembraneMesh& mm = m->solver().mesh();
+    MFSI_CHECK(static_cast<lid_t>(surf.fluidNode.size()) == mm.nNodes() &&
+                   static_cast<lid_t>(surf.masterFace.size()) == mm.nElements(),
+               "coupling: " << m->name() << "'s mesh does not match its fluid surface");
+    const bool baffle = po.mesh.kind == MembraneMeshKind::Baffle;
+    const std::string surface = baffle ? po.mesh.baffle : po.mesh.patch;
+    p.iface = coupling::makeMembraneInterface(mesh_, surf, surface,
+                                              baffle ? coupling::InterfaceSide::Baffle : coupling::InterfaceSide::Patch);
+    p.dynamic = po.analysis == MembraneAnalysis::Dynamic;
+    // The fluid walls on the membrane must move with it: either they take the membrane velocity
+    // (membraneWall: External), or the mesh velocity (movingWall).
+    for (int pi : bc.find(surface)) {
+      const fluid::ResolvedPatch& rp = bc.patches()[pi];
+      const bool external = rp.type == fluid::BoundaryType::Wall && rp.bc.wallMotion == fluid::WallMotion::External;
+      const bool meshVelocity =
+          rp.type == fluid::BoundaryType::Wall && rp.bc.wallMotion == fluid::WallMotion::MeshVelocity;
+      if (!external && !meshVelocity)
+        throw InputError(section.where(), "fluid.boundary." + rp.name + " is under " + m->name() +
+                                              ": make it 'type: membraneWall' (wall velocity from the membrane) or "
+                                              "'type: movingWall' (from the mesh motion)");
+      p.wallVelocity = p.wallVelocity || external;
+    }
+    p.load = RealView("mfsi::coupling::load", mm.nElements());
+    p.loadPrevious = RealView("mfsi::coupling::loadPrevious", mm.nElements());
+    p.faceVelocity = Real3View("mfsi::coupling::faceVelocity", mm.nElements());
+    m->solver().loads().elementPressure = p.load;
+    p.frontPatch = baffle ? surface + "_master" : surface;
+    p.backPatch = baffle ? surface + "_slave" : "";
+    if (options_.viscousTraction) {
+      p.force = Real3View("mfsi::coupling::viscousForce", mm.nNodes());
+      p.forcePrevious = Real3View("mfsi::coupling::viscousForcePrevious", mm.nNodes());
+      p.tractionFront = Real3View("mfsi::coupling::tractionFront", mm.nElements());
+      p.tractionBack = Real3View("mfsi::coupling::tractionBack", baffle ? mm.nElements() : 0);
+      p.pressureTraction = Real3View("mfsi::coupling::pressureTraction", mm.nElements());
+      m->solver().loads().nodeForce = p.force;
+    }
+    p.offset = size_;
+    layout.push_back({m->name(), size_, 3 * mm.nNodes()});
+    size_ += 3 * mm.nNodes();
+    panels_.push_back(std::move(p));
+  }
+  for (std::size_t i = 0; i < options_.motion.slidingPatches.size(); ++i) {
+    const std::string& s = options_.motion.slidingPatches[i];
+    if (mesh_.findPatch(s) < 0) {
+      std::vector<std::string> names;
+      for (const auto& pt : mesh_.patches()) names.push_back(pt.name);
+      throw InputError(section.where("meshMotion.slidingPatches." + std::to_string(i)),
+                       "the mesh has no patch '" + s + "'" + didYouMean(s, names) + "; patches: " + joinList(names));
+    }
+  }
+  smoother_ = std::make_unique<coupling::MeshSmoother>(mesh_, options_.motion);
+  acceleration_ = coupling::makeAcceleration(options_.acceleration, layout);
+}
+
+std::vector<Module*> FsiCoupling::parts() {
+  std::vector<Module*> v{fluid_.get()};
+  for (auto& m : ownedMembranes_) v.push_back(m.get());
+  return v;
+}
+
+double FsiCoupling::loadScale(double t1) const {
+  if (options_.fsiRampTime <= 0) return 1;
+  return std::clamp((t1 - options_.fsiStartTime) / options_.fsiRampTime, 0.0, 1.0);
+}
+
+void FsiCoupling::updateLoads(double scale, bool relax) {
+  ScopedTimer timer(timers_, "coupling.transfer");
+  const fluid::FluidSolver& f = fluid_->solver();
+  double change2 = 0, norm2 = 0;
+  for (Panel& p : panels_) {
+    Kokkos::deep_copy(exec_, p.loadPrevious, p.load);
+    coupling::interfacePressure(exec_, p.iface, f.boundaryPressure(), options_.outsidePressure, scale,
+                                options_.pClamp, p.load);
+    const RealView load = p.load, prev = p.loadPrevious;
+    const double w = relax ? options_.forceOmega : 1.0;
+    double c = 0, n = 0;
+    Kokkos::parallel_reduce(
+        "mfsi::coupling::loadRelaxation", RangePolicy(exec_, 0, p.iface.nElements()),
+        KOKKOS_LAMBDA(lid_t e, double& dc, double& dn) {
+          const real v = w * load(e) + (1 - w) * prev(e);
+          load(e) = v;
+          dc += (v - prev(e)) * (v - prev(e));
+          dn += v * v;
+        },
+        c, n);
+    change2 += c;
+    norm2 += n;
+    if (!options_.viscousTraction) continue;
+    Kokkos::deep_copy(exec_, p.forcePrevious, p.force);
+    fluid::boundaryTraction(f, p.frontPatch, p.pressureTraction, p.tractionFront);
+    if (!p.backPatch.empty()) fluid::boundaryTraction(f, p.backPatch, p.pressureTraction, p.tractionBack);
+    coupling::interfaceViscousForce(exec_, p.iface, p.module->solver().mesh().nodeElements(), mesh_.nInternalFaces(),
+                                    f.geometry().faceAreaMag, p.tractionFront, p.tractionBack, scale, p.force);
+    // Relaxed like the pressure; the load residual is the pressure's alone (one unit).
+    const Real3View force = p.force, fprev = p.forcePrevious;
+    Kokkos::parallel_for(
+        "mfsi::coupling::forceRelaxation", RangePolicy(exec_, 0, p.iface.nNodes()), KOKKOS_LAMBDA(lid_t i) {
+          for (int k = 0; k < 3; ++k) force(i, k) = w * force(i, k) + (1 - w) * fprev(i, k);
+        });
+  }
+  const SolverComm comm;
+  change2 = comm.globalSum(change2);
+  norm2 = comm.globalSum(norm2);
+  forceResidual_ = norm2 > 0 ? std::sqrt(change2 / norm2) : (change2 > 0 ? 1.0 : 0.0);
+}
+
+void FsiCoupling::solveStructure(double t1, double dt) {
+  ScopedTimer timer(timers_, "coupling.structure");
+  for (Panel& p : panels_) {
+    MembraneSolver& s = p.module->solver();
+    const MembraneSolveReport rep = p.dynamic ? s.solveStep(dt) : s.solveStatic(t1);
+    if (!rep.converged || !std::isfinite(rep.relativeResidual)) {
+      std::ostringstream os;
+      os << p.module->name() << ": the structure solve did not converge in the step to t = " << t1 << " ("
+         << rep.iterations << " iterations, relative residual " << rep.relativeResidual << ")";
+      throw DivergenceError(os.str());
+    }
+  }
+  ++last_.structureSolves;
+}
+
+void FsiCoupling::gatherTrial(InterfaceVector& xt) const {
+  for (const Panel& p : panels_) {
+    MembraneSolver& s = p.module->solver();
+    toHost(p.dynamic ? s.trialDisplacement() : s.displacement(), xt, p.offset);
+  }
+}
+
+void FsiCoupling::setTrial(const InterfaceVector& x) {
+  for (Panel& p : panels_) {
+    MembraneSolver& s = p.module->solver();
+    if (p.dynamic) {
+      RealView u("mfsi::coupling::relaxed", 3 * s.mesh().nNodes());
+      toDevice(x, p.offset, u);
+      s.setTrialDisplacement(u);
+    } else {
+      toDevice(x, p.offset, s.displacement());
+    }
+  }
+}
+
+void FsiCoupling::commitStructure() {
+  for (Panel& p : panels_)
+    if (p.dynamic) p.module->solver().commitStep();
+}
+
+void FsiCoupling::moveMesh(const InterfaceVector& x) {
+  {
+    ScopedTimer timer(timers_, "coupling.transfer");
+    for (Panel& p : panels_) {
+      RealView u("mfsi::coupling::meshDisplacement", p.iface.nNodes() * 3);
+      toDevice(x, p.offset, u);
+      coupling::interfaceDisplacement(exec_, p.iface, u, smoother_->displacement());
+    }
+  }
+  {
+    ScopedTimer timer(timers_, "coupling.motion");
+    const coupling::MotionReport r = smoother_->move(exec_, geometry_);
+    last_.minScaledJacobian = std::min(last_.minScaledJacobian, r.minScaledJacobian);
+    fluid_->solver().moveMesh(mesh_.points());
+    exec_.fence();
+  }
+  ScopedTimer timer(timers_, "coupling.transfer");
+  for (Panel& p : panels_) {
+    if (!p.wallVelocity) continue;
+    MembraneSolver& s = p.module->solver();
+    coupling::interfaceFaceVelocity(exec_, p.iface, s.mesh().elementNodes(), s.trialVelocity(), p.faceVelocity);
+    fluid_->solver().setWallVelocity(p.iface.surface, p.faceVelocity);
+  }
+}
+
+bool FsiCoupling::moveMeshGuarded(InterfaceVector& x, InterfaceVector& good) {
+  const InterfaceVector target = x;
+  double fraction = 1;
+  for (int cut = 0;; ++cut) {
+    try {
+      moveMesh(x);
+      good = x;
+      return cut == 0;
+    } catch (const DivergenceError&) {
+      if (cut == 6) throw;
+      ++last_.cutBacks;
+      fraction *= 0.5;
+      x = good + fraction * (target - good);
+      setTrial(x);
+    }
+  }
+}
+
+void FsiCoupling::solveFluid(const TimeState& t) {
+  ScopedTimer timer(timers_, "coupling.fluid");
+  fluid_->solveIteration(t);
+  ++last_.iterations;
+}
+
+void FsiCoupling::advance(const TimeState& t) {
+  const double t1 = t.time + t.dt;
+  last_ = StepReport{};
+  fluid_->beginStep(t);
+  if (t1 <= options_.fsiStartTime + 1e-12 * std::max(1.0, std::abs(t1))) {
+    // The structure is frozen and the mesh fixed until fsiStartTime.
+    solveFluid(t);
+    for (Panel& p : panels_) p.module->solver().setTime(t1);
+    fluid_->endStep();
+    last_.converged = true;
+    ++steps_;
+    return;
+  }
+  for (Panel& p : panels_) {
+    p.module->solver().setTime(t.time);
+    p.module->solver().discardStep();
+  }
+  const double scale = loadScale(t1);
+  updateLoads(scale, false);  // the loads of the fluid at t_n (the structure goes first)
+  InterfaceVector x(size_), xt(size_), good(size_);
+  for (const Panel& p : panels_) toHost(p.module->solver().displacement(), good, p.offset);  // the mesh is there
+  acceleration_->beginStep();
+  const bool implicit = options_.scheme == CouplingScheme::Implicit;
+  // The structure goes first, on the loads of t_n: its answer is the predictor x_1 (and the whole
+  // step's answer in the explicit scheme). It is not a value of the fixed-point map of this step
+  // (the fluid has not seen t_n+1 yet), so it never enters the acceleration's history.
+  solveStructure(t1, t.dt);
+  gatherTrial(x);
+  for (;;) {
+    // An iterate the mesh cannot follow (a quasi-Newton step too far) is cut back towards the last
+    // one it could, and the acceleration starts afresh from there.
+    if (!moveMeshGuarded(x, good)) acceleration_->resetHistory();
+    solveFluid(t);
+    updateLoads(scale, true);
+    if (!implicit) break;
+    solveStructure(t1, t.dt);
+    gatherTrial(xt);
+    const double nx = acceleration_->norm(xt), nr = acceleration_->norm(xt - x);
+    last_.displacementResidual = nx > 0 ? nr / nx : nr;
+    last_.forceResidual = forceResidual_;
+    const bool small = last_.displacementResidual < options_.fsiTol &&
+                       (options_.convergence == CouplingConvergence::Displacement || forceResidual_ < options_.fsiTol);
+    if (last_.iterations >= options_.minFsiIter && small) {
+      last_.converged = true;
+      break;
+    }
+    if (last_.iterations >= options_.maxFsiIter) break;
+    ScopedTimer timer(timers_, "coupling.acceleration");
+    const coupling::AccelerationReport ar = acceleration_->update(xt, x);
+    last_.omega = ar.omega;
+    last_.columns = ar.columns;
+    setTrial(x);
+  }
+  acceleration_->endStep();
+  // Converged (or explicit): the structure's last answer is committed; the fluid saw the mesh at x,
+  // within fsiTol of it. Not converged: the last relaxed iterate, which the mesh and fluid match.
+  if (!last_.converged && implicit) setTrial(x);
+  commitStructure();
+  fluid_->endStep();
+  for (Panel& p : panels_) p.module->sampleState();
+  ++steps_;
+  iterationsTotal_ += last_.iterations;
+  maxIterations_ = std::max(maxIterations_, last_.iterations);
+  cutBacksTotal_ += last_.cutBacks;
+  minJacobian_ = std::min(minJacobian_, last_.minScaledJacobian);
+  if (implicit && !last_.converged) {
+    ++unconvergedSteps_;
+    if (++unconvergedInARow_ >= options_.maxUnconvergedSteps) {
+      std::ostringstream os;
+      os << "coupling: maxFsiIter = " << options_.maxFsiIter << " reached on " << unconvergedInARow_
+         << " steps in a row (step to t = " << t1 << ": displacement residual " << last_.displacementResidual
+         << ", load residual " << last_.forceResidual << ", fsiTol " << options_.fsiTol
+         << "); try IQN-ILS (iqnMaxCols), a smaller time step or forceOmega < 1";
+      throw DivergenceError(os.str());
+    }
+  } else {
+    unconvergedInARow_ = 0;
+  }
+  if (!std::isfinite(last_.displacementResidual) || !std::isfinite(last_.forceResidual))
+    throw DivergenceError("coupling: non-finite interface residual in the step to t = " + std::to_string(t1));
+}
+
+std::vector<std::string> FsiCoupling::stepColumns() const {
+  return {"iterations", "displacementResidual", "forceResidual", "omega", "columns", "minScaledJacobian", "cutBacks"};
+}
+
+void FsiCoupling::appendStepValues(std::vector<double>& v) const {
+  v.insert(v.end(), {double(last_.iterations), last_.displacementResidual, last_.forceResidual, last_.omega,
+                     double(last_.columns), last_.minScaledJacobian, double(last_.cutBacks)});
+}
+
+void FsiCoupling::addMetrics(std::map<std::string, double>& m) const {
+  m["coupling.steps"] = double(steps_);
+  m["coupling.mean_iterations"] = steps_ > 0 ? double(iterationsTotal_) / double(steps_) : 0.0;
+  m["coupling.max_iterations"] = maxIterations_;
+  m["coupling.unconverged_steps"] = double(unconvergedSteps_);
+  m["coupling.min_scaled_jacobian"] = minJacobian_;
+  m["coupling.cut_backs"] = double(cutBacksTotal_);
+  const auto& all = timers_.all();
+  auto seconds = [&](const char* k) {
+    auto it = all.find(k);
+    return it == all.end() ? 0.0 : it->second;
+  };
+  const double st = seconds("coupling.structure"), mo = seconds("coupling.motion"), fl = seconds("coupling.fluid"),
+               ac = seconds("coupling.acceleration"), tr = seconds("coupling.transfer");
+  const double total = st + mo + fl + ac + tr;
+  m["coupling.time_structure_s"] = st;
+  m["coupling.time_motion_s"] = mo;
+  m["coupling.time_fluid_s"] = fl;
+  m["coupling.time_acceleration_s"] = ac;
+  m["coupling.time_transfer_s"] = tr;
+  if (total > 0) m["coupling.share_motion_transfer_acceleration"] = (mo + ac + tr) / total;
+}
+
+ModuleEntry couplingModuleEntry() {
+  return {"coupling", &couplingSchema, [](const SceneConfig& section, SimulationContext& ctx) {
+            std::vector<std::unique_ptr<Module>> out;
+            if (ctx.mesh == nullptr || ctx.built == nullptr)
+              throw InputError(section.where(), "the coupling needs the scene's 'mesh' and 'fluid' sections");
+            std::unique_ptr<FluidModule> fluid;
+            std::vector<std::unique_ptr<MembraneModule>> membranes;
+            std::vector<std::unique_ptr<Module>> rest;
+            for (auto& m : *ctx.built) {
+              if (auto* f = dynamic_cast<FluidModule*>(m.get())) {
+                fluid.reset(f);
+                m.release();
+              } else if (auto* mm = dynamic_cast<MembraneModule*>(m.get());
+                         mm != nullptr && (mm->panel().mesh.kind == MembraneMeshKind::Baffle ||
+                                           mm->panel().mesh.kind == MembraneMeshKind::Patch)) {
+                membranes.emplace_back(mm);
+                m.release();
+              } else {
+                rest.push_back(std::move(m));
+              }
+            }
+            *ctx.built = std::move(rest);
+            if (!fluid) throw InputError(section.where(), "the coupling needs the scene's 'fluid' section");
+            out.push_back(std::make_unique<FsiCoupling>(readCouplingOptions(section), section, *ctx.mesh,
+                                                        *ctx.geometry, *ctx.timers, std::move(fluid),
+                                                        std::move(membranes)));
+            return out;
+          }};
+}
+
+}  // namespace mfsi

@@ -1,0 +1,124 @@
+#pragma once
+/// \file
+/// \brief The FSI orchestrator: the `coupling` section as a module that owns the fluid and the
+/// membranes cut from its mesh, and advances them together.
+///
+/// One time step, implicit scheme (the seed's section 5.1, structure first):
+///   fluid.beginStep; f = membrane loads from the fluid at t_n
+///   structure: every membrane solves the step on f -> x (the predictor)
+///   repeat
+///     mesh motion: membrane nodes at x, interior nodes smoothed, quality guarded
+///     fluid: PIMPLE on the moved mesh, membrane wall velocities -> f (forceOmega, ramp, pClamp)
+///     structure: every membrane solves the step on f (from the step-start state) -> x~ = H(x)
+///     converged when at least minFsiIter fluid solves ran and |x~ - x| / |x~| < fsiTol (and,
+///       `both`, |f - f_prev| / |f| < fsiTol): commit x~, done
+///     acceleration (Aitken / IQN-ILS) on (x, x~): x <- next iterate
+/// The predictor is not a value of this step's fixed-point map H (the fluid had not seen t_n+1),
+/// so it never enters the acceleration's history. The explicit scheme stops after the first fluid
+/// solve, with the predictor as the step's structure. `coupling.iterations` counts fluid solves
+/// per step, each followed by a structure solve, as peers count coupling iterations (the
+/// predictor makes structure solves = iterations + 1).
+///
+/// Membrane state never leaks from one iteration into the next: a dynamic membrane re-solves the
+/// step from its committed state (MembraneSolver::solveStep) and commits once; the fluid re-solves
+/// the step from its current iterate on the moved mesh, its time levels set at beginStep.
+#include "coupling/FluidModule.hpp"
+#include "coupling/MembraneModule.hpp"
+#include "coupling/interface/MembraneInterface.hpp"
+#include "coupling/motion/MeshSmoother.hpp"
+#include "coupling/orchestrator/CouplingConfig.hpp"
+
+#include <memory>
+#include <vector>
+
+namespace mfsi {
+
+class FsiCoupling final : public Module {
+ public:
+  /// Couples `fluid` with every membrane in `membranes` (each cut from the fluid mesh). The mesh and
+  /// its geometry (the scene's) must outlive the module. Throws InputError naming the section for
+  /// membranes that are not on the fluid mesh or fluid walls that cannot follow them.
+  FsiCoupling(const CouplingOptions& options, const SceneConfig& section, HexMesh& mesh, MeshGeometry& geometry,
+              Timers& timers, std::unique_ptr<FluidModule> fluid,
+              std::vector<std::unique_ptr<MembraneModule>> membranes);
+
+  void advance(const TimeState& t) override;
+  void addMetrics(std::map<std::string, double>& metrics) const override;
+  std::vector<std::string> stepColumns() const override;
+  void appendStepValues(std::vector<double>& values) const override;
+  std::vector<Module*> parts() override;
+
+  FluidModule& fluid() { return *fluid_; }
+  MembraneModule& membrane(std::size_t i) { return *panels_[i].module; }
+  std::size_t membraneCount() const { return panels_.size(); }
+
+  /// \brief What the last step did.
+  struct StepReport {
+    int iterations = 0;        ///< fluid solves
+    int structureSolves = 0;
+    bool converged = false;
+    double displacementResidual = 0;  ///< relative, of the last check
+    double forceResidual = 0;         ///< relative, of the last check
+    double omega = 1;                 ///< last relaxation factor (quasi-Newton: 1)
+    int columns = 0;                  ///< quasi-Newton columns of the last update
+    double minScaledJacobian = 1;
+    int cutBacks = 0;  ///< iterates the mesh could not follow, cut back towards the last good one
+  };
+  const StepReport& lastStep() const { return last_; }
+
+ public:
+  // --- the steps of advance() -----------------------------------------------------------------
+  // Public only because nvcc compiles extended device lambdas (KOKKOS_LAMBDA) solely in public
+  // member functions. They expect the state advance() sets up around them: not API.
+  struct Panel {
+    MembraneModule* module = nullptr;
+    coupling::MembraneInterface iface;
+    bool dynamic = false;
+    bool wallVelocity = false;  ///< the fluid takes the membrane velocity (External walls)
+    RealView load, loadPrevious;  ///< element pressure in use, and of the previous iteration
+    Real3View force, forcePrevious;  ///< viscous nodal forces in use, and of the previous iteration
+    Real3View tractionFront, tractionBack, pressureTraction;  ///< per face, work of boundaryTraction
+    std::string frontPatch, backPatch;  ///< fluid patch names of the faces (back: baffle only)
+    Real3View faceVelocity;
+    Eigen::Index offset = 0;
+  };
+  /// Membrane loads from the fluid (times `scale`); with `relax`, forceOmega-blended with the
+  /// previous ones. Sets the load residual.
+  void updateLoads(double scale, bool relax);
+  void solveStructure(double t1, double dt);
+  void gatherTrial(coupling::InterfaceVector& xt) const;
+  void setTrial(const coupling::InterfaceVector& x);
+  void commitStructure();
+  void moveMesh(const coupling::InterfaceVector& x);
+  /// moveMesh(x), or, when the mesh cannot follow x (a cell would invert), the largest step from
+  /// `good` towards x that it can follow (halved up to 6 times; x is overwritten); then `good` = x.
+  /// Returns false when x was cut back. Throws DivergenceError when not even 1/64 of it works.
+  bool moveMeshGuarded(coupling::InterfaceVector& x, coupling::InterfaceVector& good);
+  void solveFluid(const TimeState& t);
+  double loadScale(double t1) const;
+
+ private:
+
+  CouplingOptions options_;
+  HexMesh& mesh_;
+  MeshGeometry& geometry_;
+  Timers& timers_;
+  ExecSpace exec_;
+  std::unique_ptr<FluidModule> fluid_;
+  std::vector<std::unique_ptr<MembraneModule>> ownedMembranes_;
+  std::vector<Panel> panels_;
+  std::unique_ptr<coupling::MeshSmoother> smoother_;
+  std::unique_ptr<coupling::Acceleration> acceleration_;
+  Eigen::Index size_ = 0;
+  double forceResidual_ = 0;
+  StepReport last_;
+  long long steps_ = 0, iterationsTotal_ = 0, unconvergedSteps_ = 0, unconvergedInARow_ = 0, cutBacksTotal_ = 0;
+  int maxIterations_ = 0;
+  double minJacobian_ = 1;
+};
+
+/// Catalogue entry of the `coupling` section (needs the `fluid` section and at least one membrane
+/// cut from the mesh).
+ModuleEntry couplingModuleEntry();
+
+}  // namespace mfsi

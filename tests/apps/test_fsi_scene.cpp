@@ -1,0 +1,176 @@
+// Two-way FSI end to end (scene -> Simulation -> FsiCoupling): cases/flexible-cavity.yaml
+//  - meets Mok's digitized mid-point displacement at t = 4 s (32 x 32, the benchmark's mesh);
+//  - IQN-ILS, Aitken and IQN-ILS with reused columns reach the same fixed point (to fsiTol's
+//    level), each step converged;
+//  - the explicit scheme makes one pass per step and lands elsewhere;
+//  - coupling input errors name the key; without a `coupling` section nothing is coupled.
+#include "support/Approx.hpp"
+
+#include "coupling/Module.hpp"
+#include "coupling/Simulation.hpp"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+#include <string>
+#include <vector>
+
+using mfsi::test::near;
+using mfsi::test::Tol;
+
+namespace {
+
+const std::string kScene = std::string(MFSI_CASES_DIR) + "/flexible-cavity.yaml";
+
+mfsi::RunResult run(const std::vector<std::string>& sets, const std::string& tag) {
+  auto cfg = mfsi::SceneConfig::load(kScene, mfsi::sceneSchema(), sets);
+  mfsi::Simulation sim(cfg);
+  const std::string dir = ::testing::TempDir() + "/fsi_scene_" + tag;
+  std::filesystem::create_directories(dir);
+  return sim.run(dir, false);
+}
+
+std::vector<std::string> coarse(int n, double endTime) {
+  const int top = std::max(1, n / 8);
+  return {"mesh.blocks.0.cells=[" + std::to_string(n) + "," + std::to_string(n - top) + ",1]",
+          "mesh.blocks.1.cells=[" + std::to_string(n) + "," + std::to_string(top) + ",1]",
+          "time.endTime=" + std::to_string(endTime)};
+}
+
+/// Linear interpolation in a two-column CSV (comment lines start with '#', one header line).
+double interpolate(const std::string& file, double t) {
+  std::ifstream in(file);
+  EXPECT_TRUE(in.good()) << file;
+  std::string line;
+  std::vector<double> ts, ys;
+  bool header = true;
+  while (std::getline(in, line)) {
+    if (line.empty() || line[0] == '#') continue;
+    if (header) {
+      header = false;
+      continue;
+    }
+    std::istringstream s(line);
+    double a, b;
+    char c;
+    s >> a >> c >> b;
+    ts.push_back(a);
+    ys.push_back(b);
+  }
+  for (std::size_t i = 1; i < ts.size(); ++i)
+    if (ts[i] >= t) return ys[i - 1] + (ys[i] - ys[i - 1]) * (t - ts[i - 1]) / (ts[i] - ts[i - 1]);
+  return NAN;
+}
+
+std::string inputError(const std::vector<std::string>& sets) {
+  try {
+    auto cfg = mfsi::SceneConfig::load(kScene, mfsi::sceneSchema(), sets);
+    mfsi::Simulation sim(cfg);
+  } catch (const mfsi::InputError& e) {
+    return e.what();
+  }
+  return "";
+}
+
+}  // namespace
+
+TEST(FsiScene, FlexibleCavityMeetsMokAtFourSeconds) {
+  const auto r = run(coarse(32, 4.0), "mok");
+  const auto& m = r.metrics;
+  const double mok = interpolate(std::string(MFSI_TEST_DATA_DIR) + "/flexible_cavity_mok2001.csv", 4.0);
+  std::printf("t = 4 s: mid-point u_y %.5f, Mok %.5f; %.2f coupling iterations per step (max %.0f)\n",
+              m.at("membrane.bottom.centreUy"), mok, m.at("coupling.mean_iterations"),
+              m.at("coupling.max_iterations"));
+  ASSERT_NEAR(mok, 0.0825, 0.002) << "the digitized curve itself";
+  // The digitization is good to +-0.002 (2.4 % here); 5 % allows for it.
+  EXPECT_TRUE(near(m.at("membrane.bottom.centreUy"), mok, Tol{0, 0.05}));
+  EXPECT_EQ(m.at("coupling.unconverged_steps"), 0);
+  EXPECT_LE(m.at("coupling.mean_iterations"), 5.0);
+  EXPECT_GT(m.at("coupling.min_scaled_jacobian"), 0.5);
+}
+
+TEST(FsiScene, EveryAccelerationReachesTheSameFixedPoint) {
+  auto sets = coarse(16, 3.0);
+  const auto iqn = run(sets, "iqn").metrics;
+  auto aitkenSets = sets;
+  aitkenSets.push_back("coupling.iqnMaxCols=0");
+  const auto aitken = run(aitkenSets, "aitken").metrics;
+  auto reuseSets = sets;
+  reuseSets.push_back("coupling.iqnReuseCols=4");
+  const auto reuse = run(reuseSets, "reuse").metrics;
+  const double w = iqn.at("membrane.bottom.centreUy");
+  std::printf("u_y(3 s): IQN-ILS %.7f (%.2f it/step), Aitken %.7f (%.2f), IQN-ILS reuse 4 %.7f (%.2f)\n", w,
+              iqn.at("coupling.mean_iterations"), aitken.at("membrane.bottom.centreUy"),
+              aitken.at("coupling.mean_iterations"), reuse.at("membrane.bottom.centreUy"),
+              reuse.at("coupling.mean_iterations"));
+  EXPECT_GT(w, 0.01);
+  for (const auto* m : {&iqn, &aitken, &reuse}) EXPECT_EQ(m->at("coupling.unconverged_steps"), 0);
+  // fsiTol = 1e-5 on each step's displacement; over 30 steps the answers agree to ~1e-4.
+  EXPECT_TRUE(near(aitken.at("membrane.bottom.centreUy"), w, Tol{0, 2e-4}));
+  EXPECT_TRUE(near(reuse.at("membrane.bottom.centreUy"), w, Tol{0, 2e-4}));
+  EXPECT_NE(reuse.at("coupling.mean_iterations"), iqn.at("coupling.mean_iterations"))
+      << "reused columns change the iterations";
+}
+
+TEST(FsiScene, TheExplicitSchemeMakesOnePassAndLandsElsewhere) {
+  auto sets = coarse(16, 1.0);
+  const auto implicit = run(sets, "implicit1").metrics;
+  sets.push_back("coupling.scheme=explicit");
+  double explicitW = NAN;
+  try {
+    const auto e = run(sets, "explicit1").metrics;
+    EXPECT_EQ(e.at("coupling.max_iterations"), 1);
+    explicitW = e.at("membrane.bottom.centreUy");
+  } catch (const mfsi::DivergenceError& e) {
+    std::printf("explicit: diverged (%s)\n", e.what());
+    SUCCEED();
+    return;
+  }
+  std::printf("u_y(1 s): implicit %.4e, explicit %.4e\n", implicit.at("membrane.bottom.centreUy"), explicitW);
+  EXPECT_FALSE(near(explicitW, implicit.at("membrane.bottom.centreUy"), Tol{0, 1e-2}));
+}
+
+TEST(FsiScene, CouplingInputErrorsNameTheKey) {
+  // The membrane's wall must move with it.
+  std::string e = inputError({"fluid.boundary.bottom.type=wall"});
+  EXPECT_NE(e.find("membraneWall"), std::string::npos) << e;
+  EXPECT_NE(e.find("fluid.boundary.bottom"), std::string::npos) << e;
+  // A sliding patch that does not exist: file, line and key.
+  e = inputError({"coupling.meshMotion.slidingPatches=[wals]"});
+  std::printf("%s\n", e.c_str());
+  EXPECT_NE(e.find("--set"), std::string::npos) << e;
+  EXPECT_NE(e.find("slidingPatches"), std::string::npos) << e;
+  EXPECT_NE(e.find("did you mean 'walls'"), std::string::npos) << e;
+  // Schema errors: an unknown key and a bound.
+  e = inputError({"coupling.fsiTolerance=1e-5"});
+  EXPECT_NE(e.find("fsiTolerance"), std::string::npos) << e;
+  e = inputError({"coupling.minFsiIter=50"});
+  EXPECT_NE(e.find("minFsiIter"), std::string::npos) << e;
+}
+
+TEST(FsiScene, WithoutACouplingSectionNothingIsCoupled) {
+  const int before = mfsi::Module::constructionCounts().count("coupling")
+                         ? mfsi::Module::constructionCounts().at("coupling")
+                         : 0;
+  // The same scene without `coupling`: fluid and membrane advance side by side, the membrane sees
+  // no fluid load and stays flat.
+  std::ifstream in(kScene);
+  std::stringstream s;
+  s << in.rdbuf();
+  std::string yaml = s.str();
+  yaml = yaml.substr(0, yaml.find("\ncoupling:")) + "\n";
+  auto cfg = mfsi::SceneConfig::fromString(yaml, "uncoupled.yaml", mfsi::sceneSchema(), coarse(8, 0.3));
+  mfsi::Simulation sim(cfg);
+  const std::string dir = ::testing::TempDir() + "/fsi_scene_uncoupled";
+  std::filesystem::create_directories(dir);
+  const auto r = sim.run(dir, false);
+  const int after = mfsi::Module::constructionCounts().count("coupling")
+                        ? mfsi::Module::constructionCounts().at("coupling")
+                        : 0;
+  EXPECT_EQ(after, before);
+  EXPECT_EQ(r.metrics.count("coupling.mean_iterations"), 0u);
+  EXPECT_TRUE(near(r.metrics.at("membrane.bottom.maxDisplacement"), 0.0, Tol{1e-12, 0}));
+}
