@@ -2,6 +2,10 @@
 
 #include "core/Error.hpp"
 
+#include <algorithm>
+#include <map>
+#include <utility>
+
 namespace mfsi::coupling {
 
 namespace {
@@ -76,6 +80,60 @@ void interfaceViscousForce(const ExecSpace& exec, const MembraneInterface& iface
         }
         for (int c = 0; c < 3; ++c) nodeForce(n, c) = f[c];
       });
+}
+
+ElementGraph elementGraph(const std::vector<std::array<lid_t, 4>>& elements, const std::vector<real>& areas) {
+  // Edge -> the elements on it; an interior edge has two.
+  std::map<std::pair<lid_t, lid_t>, std::vector<lid_t>> edges;
+  for (std::size_t e = 0; e < elements.size(); ++e) {
+    const int n = elements[e][3] < 0 ? 3 : 4;
+    for (int a = 0; a < n; ++a) {
+      lid_t i = elements[e][a], j = elements[e][(a + 1) % n];
+      if (i > j) std::swap(i, j);
+      edges[{i, j}].push_back(static_cast<lid_t>(e));
+    }
+  }
+  std::vector<std::vector<lid_t>> nb(elements.size());
+  for (const auto& [edge, els] : edges)
+    if (els.size() == 2) {
+      nb[els[0]].push_back(els[1]);
+      nb[els[1]].push_back(els[0]);
+    }
+  std::vector<lid_t> off(elements.size() + 1, 0), list;
+  for (std::size_t e = 0; e < elements.size(); ++e) {
+    std::sort(nb[e].begin(), nb[e].end());
+    list.insert(list.end(), nb[e].begin(), nb[e].end());
+    off[e + 1] = static_cast<lid_t>(list.size());
+  }
+  ElementGraph g;
+  g.offsets = toDevice(off, "mfsi::coupling::interface::elementOffsets", 0);
+  g.neighbours = toDevice(list, "mfsi::coupling::interface::elementNeighbours", 0);
+  g.area = RealView("mfsi::coupling::interface::elementArea", areas.size());
+  auto ha = Kokkos::create_mirror_view(g.area);
+  for (std::size_t e = 0; e < areas.size(); ++e) ha(e) = areas[e];
+  Kokkos::deep_copy(g.area, ha);
+  return g;
+}
+
+void smoothInterfacePressure(const ExecSpace& exec, const ElementGraph& g, const RealView& p, const RealView& work,
+                             int iterations) {
+  const ConstIndexView off = g.offsets, nb = g.neighbours;
+  const ConstRealView area = g.area;
+  for (int it = 0; it < iterations; ++it) {
+    Kokkos::deep_copy(exec, work, p);
+    const ConstRealView in = work;
+    Kokkos::parallel_for(
+        "mfsi::coupling::interface::smoothPressure", RangePolicy(exec, 0, static_cast<lid_t>(p.extent(0))),
+        KOKKOS_LAMBDA(lid_t e) {
+          real s = 0;
+          for (lid_t k = off(e); k < off(e + 1); ++k) {
+            const lid_t n = nb(k);
+            const real m = area(e) < area(n) ? area(e) : area(n);
+            s += m * (in(n) - in(e));
+          }
+          p(e) = in(e) + s / (8 * area(e));
+        });
+  }
 }
 
 void interfaceDisplacement(const ExecSpace& exec, const MembraneInterface& iface, const ConstRealView& u,

@@ -20,6 +20,7 @@
 
 #include <array>
 #include <string>
+#include <vector>
 
 namespace mfsi::coupling {
 
@@ -60,6 +61,21 @@ std::array<double, 3> interfaceForce(const ExecSpace& exec, const MembraneInterf
 void interfaceViscousForce(const ExecSpace& exec, const MembraneInterface& iface, const NodeItemMap& nodeElements,
                            lid_t nInternalFaces, const ConstRealView& faceAreaMag, const ConstReal3View& tvFront,
                            const ConstReal3View& tvBack, real scale, const Real3View& nodeForce);
+
+/// \brief Elements sharing an edge with each element (CSR), and the reference element areas: what
+/// the load smoothing walks.
+struct ElementGraph {
+  IndexView offsets, neighbours;
+  RealView area;
+};
+ElementGraph elementGraph(const std::vector<std::array<lid_t, 4>>& elements, const std::vector<real>& areas);
+
+/// \brief `iterations` explicit steps of conservative diffusion of the element pressure over the
+/// surface (the seed's pNetSmoothIter): p_e += (1 / (8 A_e)) sum_n min(A_e, A_n) (p_n - p_e). The
+/// exchange is antisymmetric, so sum_e A_e p_e is kept to round-off; 1/8 keeps it stable for up to
+/// four neighbours. `work` has the size of p.
+void smoothInterfacePressure(const ExecSpace& exec, const ElementGraph& g, const RealView& p, const RealView& work,
+                             int iterations);
 
 /// \brief meshDisplacement(fluidNode(i)) = u(3 i .. 3 i + 2) for every membrane node.
 void interfaceDisplacement(const ExecSpace& exec, const MembraneInterface& iface, const ConstRealView& u,

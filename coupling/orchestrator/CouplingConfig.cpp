@@ -78,6 +78,16 @@ Schema couplingSchema() {
                              .greaterThan(0)
                              .atMost(1),
            Default(o.forceOmega))
+      .key("pNetFilterTau",
+           Schema::real("time constant of a low-pass (IIR) filter on the membrane load; its state advances once per "
+                        "step (0: off)",
+                        "s")
+               .atLeast(0),
+           Default(o.pNetFilterTau))
+      .key("pNetSmoothIter",
+           Schema::integer("steps of conservative smoothing of the membrane load over its surface (total force kept)")
+               .atLeast(0),
+           Default(o.pNetSmoothIter))
       .key("fsiStartTime", Schema::real("structure frozen (mesh fixed) before this time", "s").atLeast(0),
            Default(o.fsiStartTime))
       .key("fsiRampTime", Schema::real("load ramp 0 -> 100 % after fsiStartTime (0: none)", "s").atLeast(0),
@@ -120,6 +130,8 @@ CouplingOptions readCouplingOptions(const SceneConfig& c) {
   if (a.omegaMin > a.omegaInit && a.method == coupling::AccelerationMethod::Aitken)
     throw InputError(c.where("omegaMin"), "omegaMin exceeds omegaInit");
   o.forceOmega = c.get<double>("forceOmega");
+  o.pNetFilterTau = c.get<double>("pNetFilterTau");
+  o.pNetSmoothIter = c.get<int>("pNetSmoothIter");
   o.fsiStartTime = c.get<double>("fsiStartTime");
   o.fsiRampTime = c.get<double>("fsiRampTime");
   o.pClamp = c.get<double>("pClamp");

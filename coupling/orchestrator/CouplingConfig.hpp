@@ -14,6 +14,8 @@
 ///   iqnMaxCols: 30          # > 0: IQN-ILS instead of Aitken
 ///   iqnReuseCols: 0         # past steps whose columns IQN-ILS reuses
 ///   forceOmega: 1           # under-relaxation of the membrane load between iterations
+///   pNetFilterTau: 0        # low-pass of the load in time (s), once per step
+///   pNetSmoothIter: 0       # conservative smoothing of the load over the surface
 ///   fsiStartTime: 0         # structure frozen before this time
 ///   fsiRampTime: 0          # load ramp 0 -> 100 % after fsiStartTime
 ///   outsidePressure: 0      # pressure behind a membrane that replaces a wall patch
@@ -45,6 +47,8 @@ struct CouplingOptions {
   int maxUnconvergedSteps = 3;
   coupling::AccelerationOptions acceleration;
   double forceOmega = 1;      ///< load under-relaxation between iterations (1: none)
+  double pNetFilterTau = 0;   ///< s: low-pass of the load in time, alpha = dt / (tau + dt), state kept per step (0: off)
+  int pNetSmoothIter = 0;     ///< conservative smoothing steps of the load over the membrane surface
   double fsiStartTime = 0;    ///< s
   double fsiRampTime = 0;     ///< s
   double pClamp = 0;          ///< |pNet| limit [Pa] (0: none)

@@ -83,6 +83,11 @@ FsiCoupling::FsiCoupling(const CouplingOptions& options, const SceneConfig& sect
     p.load = RealView("mfsi::coupling::load", mm.nElements());
     p.loadPrevious = RealView("mfsi::coupling::loadPrevious", mm.nElements());
     p.faceVelocity = Real3View("mfsi::coupling::faceVelocity", mm.nElements());
+    if (options_.pNetSmoothIter > 0) {
+      p.graph = coupling::elementGraph(mm.hostElements(), mm.elementAreas());
+      p.smoothWork = RealView("mfsi::coupling::smoothWork", mm.nElements());
+    }
+    if (options_.pNetFilterTau > 0) p.filtered = RealView("mfsi::coupling::filteredLoad", mm.nElements());
     m->solver().loads().elementPressure = p.load;
     p.frontPatch = baffle ? surface + "_master" : surface;
     p.backPatch = baffle ? surface + "_slave" : "";
@@ -123,7 +128,15 @@ double FsiCoupling::loadScale(double t1) const {
   return std::clamp((t1 - options_.fsiStartTime) / options_.fsiRampTime, 0.0, 1.0);
 }
 
-void FsiCoupling::updateLoads(double scale, bool relax) {
+void FsiCoupling::advanceLoadFilter() {
+  if (options_.pNetFilterTau <= 0) return;
+  for (Panel& p : panels_) {
+    Kokkos::deep_copy(exec_, p.filtered, p.load);
+    p.haveFiltered = true;
+  }
+}
+
+void FsiCoupling::updateLoads(double scale, bool relax, double dt) {
   ScopedTimer timer(timers_, "coupling.transfer");
   const fluid::FluidSolver& f = fluid_->solver();
   double change2 = 0, norm2 = 0;
@@ -131,7 +144,16 @@ void FsiCoupling::updateLoads(double scale, bool relax) {
     Kokkos::deep_copy(exec_, p.loadPrevious, p.load);
     coupling::interfacePressure(exec_, p.iface, f.boundaryPressure(), options_.outsidePressure, scale,
                                 options_.pClamp, p.load);
+    if (options_.pNetSmoothIter > 0)
+      coupling::smoothInterfacePressure(exec_, p.graph, p.load, p.smoothWork, options_.pNetSmoothIter);
     const RealView load = p.load, prev = p.loadPrevious;
+    if (options_.pNetFilterTau > 0 && p.haveFiltered) {
+      const real alpha = dt / (options_.pNetFilterTau + dt);
+      const RealView old = p.filtered;
+      Kokkos::parallel_for(
+          "mfsi::coupling::loadFilter", RangePolicy(exec_, 0, p.iface.nElements()),
+          KOKKOS_LAMBDA(lid_t e) { load(e) = alpha * load(e) + (1 - alpha) * old(e); });
+    }
     const double w = relax ? options_.forceOmega : 1.0;
     double c = 0, n = 0;
     Kokkos::parallel_reduce(
@@ -271,7 +293,7 @@ void FsiCoupling::advance(const TimeState& t) {
     p.module->solver().discardStep();
   }
   const double scale = loadScale(t1);
-  updateLoads(scale, false);  // the loads of the fluid at t_n (the structure goes first)
+  updateLoads(scale, false, t.dt);  // the loads of the fluid at t_n (the structure goes first)
   InterfaceVector x(size_), xt(size_), good(size_);
   for (const Panel& p : panels_) toHost(p.module->solver().displacement(), good, p.offset);  // the mesh is there
   acceleration_->beginStep();
@@ -286,7 +308,7 @@ void FsiCoupling::advance(const TimeState& t) {
     // one it could, and the acceleration starts afresh from there.
     if (!moveMeshGuarded(x, good)) acceleration_->resetHistory();
     solveFluid(t);
-    updateLoads(scale, true);
+    updateLoads(scale, true, t.dt);
     if (!implicit) break;
     solveStructure(t1, t.dt);
     gatherTrial(xt);
@@ -311,6 +333,7 @@ void FsiCoupling::advance(const TimeState& t) {
   // within fsiTol of it. Not converged: the last relaxed iterate, which the mesh and fluid match.
   if (!last_.converged && implicit) setTrial(x);
   commitStructure();
+  advanceLoadFilter();
   fluid_->endStep();
   for (Panel& p : panels_) p.module->sampleState();
   ++steps_;

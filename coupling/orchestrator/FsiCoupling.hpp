@@ -81,10 +81,16 @@ class FsiCoupling final : public Module {
     std::string frontPatch, backPatch;  ///< fluid patch names of the faces (back: baffle only)
     Real3View faceVelocity;
     Eigen::Index offset = 0;
+    coupling::ElementGraph graph;  ///< pNetSmoothIter
+    RealView smoothWork;
+    RealView filtered;             ///< pNetFilterTau: the filtered load of the last step
+    bool haveFiltered = false;
   };
   /// Membrane loads from the fluid (times `scale`); with `relax`, forceOmega-blended with the
   /// previous ones. Sets the load residual.
-  void updateLoads(double scale, bool relax);
+  void updateLoads(double scale, bool relax, double dt);
+  /// The filter state of pNetFilterTau advances to the step's last load.
+  void advanceLoadFilter();
   void solveStructure(double t1, double dt);
   void gatherTrial(coupling::InterfaceVector& xt) const;
   void setTrial(const coupling::InterfaceVector& x);

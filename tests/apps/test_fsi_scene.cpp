@@ -136,6 +136,30 @@ TEST(FsiScene, TheExplicitSchemeMakesOnePassAndLandsElsewhere) {
   EXPECT_FALSE(near(explicitW, implicit.at("membrane.bottom.centreUy"), Tol{0, 1e-2}));
 }
 
+TEST(FsiScene, TheLoadFilterTheRampAndTheStartTimeHoldTheResponseBack) {
+  const auto plain = run(coarse(16, 3.0), "plain").metrics.at("membrane.bottom.centreUy");
+  auto sets = coarse(16, 3.0);
+  sets.push_back("coupling.pNetFilterTau=1");
+  const auto filtered = run(sets, "filtered").metrics;
+  // The ramp halves the load at t = 1 s (the response there is still nearly linear in the load).
+  const auto plain1 = run(coarse(16, 1.0), "plain1").metrics.at("membrane.bottom.centreUy");
+  auto ramp = coarse(16, 1.0);
+  ramp.push_back("coupling.fsiRampTime=2");
+  const auto ramped = run(ramp, "ramped").metrics.at("membrane.bottom.centreUy");
+  auto frozen = coarse(16, 3.0);
+  frozen.push_back("coupling.fsiStartTime=3");
+  const auto still = run(frozen, "frozen").metrics;
+  std::printf("u_y(3 s): plain %.5f, pNetFilterTau = 1 s %.5f; u_y(1 s): plain %.3e, fsiRampTime = 2 s %.3e; "
+              "frozen until 3 s %.2e\n",
+              plain, filtered.at("membrane.bottom.centreUy"), plain1, ramped, still.at("membrane.bottom.centreUy"));
+  ASSERT_GT(plain, 0.01);
+  EXPECT_LT(filtered.at("membrane.bottom.centreUy"), 0.9 * plain);
+  EXPECT_EQ(filtered.at("coupling.unconverged_steps"), 0);
+  ASSERT_GT(std::abs(plain1), 1e-3);
+  EXPECT_LT(std::abs(ramped), 0.7 * std::abs(plain1));
+  EXPECT_EQ(still.at("membrane.bottom.maxDisplacement"), 0.0) << "structure frozen until fsiStartTime";
+}
+
 TEST(FsiScene, CouplingInputErrorsNameTheKey) {
   // The membrane's wall must move with it.
   std::string e = inputError({"fluid.boundary.bottom.type=wall"});

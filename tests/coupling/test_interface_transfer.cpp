@@ -197,3 +197,46 @@ TEST(InterfaceTransfer, DisplacementsLandOnTheirFluidNodesAndVelocitiesOnTheirFa
       EXPECT_TRUE(near(hf(e, k), m, Tol{1e-15, 1e-14})) << "face " << e;
     }
 }
+
+TEST(InterfaceTransfer, LoadSmoothingKeepsTheTotalForceAndDampsACheckerboard) {
+  auto mesh = box(false);
+  const auto surf = mfsi::membraneMeshFromPatch(mesh, "bottom");
+  // A graded patch would have unequal areas: stretch the reference areas to make them unequal.
+  const auto mm = mfsi::buildMembraneMesh(surf.mesh);
+  std::vector<real> areas(mm.elementAreas());
+  for (std::size_t e = 0; e < areas.size(); ++e) areas[e] *= 1 + 0.5 * (e % 3);
+  const auto g = cpl::elementGraph(mm.hostElements(), areas);
+  const lid_t ne = mm.nElements();
+  mfsi::RealView p("p", ne), work("work", ne);
+  auto hp = Kokkos::create_mirror_view(p);
+  // Checkerboard on the 4 x 3 grid of faces, plus a mean.
+  const auto& X = mm.hostPoints();
+  const auto& el = mm.hostElements();
+  for (lid_t e = 0; e < ne; ++e) {
+    double cx = 0, cz = 0;
+    for (int a = 0; a < 4; ++a) {
+      cx += 0.25 * X[el[e][a]][0];
+      cz += 0.25 * X[el[e][a]][2];
+    }
+    const int i = static_cast<int>(cx / 0.5), k = static_cast<int>(cz / 0.5);
+    hp(e) = 2 + ((i + k) % 2 == 0 ? 1.0 : -1.0);
+  }
+  Kokkos::deep_copy(p, hp);
+  auto totalAndSpread = [&]() {
+    Kokkos::View<double*, Kokkos::HostSpace> h("h", ne);
+    Kokkos::deep_copy(h, p);
+    double t = 0, lo = 1e300, hi = -1e300;
+    for (lid_t e = 0; e < ne; ++e) {
+      t += areas[e] * h(e);
+      lo = std::min(lo, h(e));
+      hi = std::max(hi, h(e));
+    }
+    return std::array<double, 2>{t, hi - lo};
+  };
+  const auto before = totalAndSpread();
+  cpl::smoothInterfacePressure(mfsi::ExecSpace(), g, p, work, 10);
+  const auto after = totalAndSpread();
+  EXPECT_TRUE(near(after[0], before[0], Tol{1e-13, 1e-14})) << "sum A p kept";
+  EXPECT_NEAR(before[1], 2.0, 1e-14);
+  EXPECT_LT(after[1], 0.5 * before[1]) << "the checkerboard is damped";
+}
