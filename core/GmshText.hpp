@@ -3,7 +3,7 @@
 /// \brief The parts of reading a Gmsh MSH 4.1 ASCII file that every mesh reader shares: a lexer
 /// that knows the line of each token (for messages "<file>:<line>: ..."), the sections $MeshFormat,
 /// $PhysicalNames, $Entities and $Nodes, and the block structure of $Elements. A reader (hexahedral
-/// volume meshes in core/GmshReader.cpp, membrane surfaces in structure/MembraneMeshImport.cpp)
+/// volume meshes in core/GmshReader.cpp, membrane surfaces in structure/membrane/MembraneMeshImport.cpp)
 /// only says what it does with each element block.
 #include "core/Types.hpp"
 

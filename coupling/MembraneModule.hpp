@@ -8,8 +8,8 @@
 /// one implicit step per run step from the initial shape. Either throws DivergenceError when a
 /// solve does not converge or the state is not finite.
 #include "coupling/Module.hpp"
-#include "structure/MembraneConfig.hpp"
-#include "structure/MembraneSolver.hpp"
+#include "structure/membrane/MembraneConfig.hpp"
+#include "structure/membrane/MembraneSolver.hpp"
 
 #include <memory>
 

@@ -1,6 +1,6 @@
 #include "coupling/RigidModule.hpp"
 
-#include "structure/RigidConfig.hpp"
+#include "structure/rigid/RigidConfig.hpp"
 
 #include <cmath>
 

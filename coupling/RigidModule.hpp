@@ -2,7 +2,7 @@
 /// \file
 /// \brief The `bodies` section as a module of a run: rigid frames on joints and restraints.
 #include "coupling/Module.hpp"
-#include "structure/RigidBodySystem.hpp"
+#include "structure/rigid/RigidBodySystem.hpp"
 
 #include <fstream>
 

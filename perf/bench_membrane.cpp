@@ -14,7 +14,7 @@
 // values of its node's elements (~ 4 x 12 x 8 B) + the CSR row written, per matrix entry ~ 16 B.
 #include "support/BenchMain.hpp"
 
-#include "structure/MembraneSolver.hpp"
+#include "structure/membrane/MembraneSolver.hpp"
 
 #include <cmath>
 

@@ -16,7 +16,7 @@
 /// surface meshes) can stand beside it with the same three transfers.
 #include "core/MeshGeometry.hpp"
 #include "kernels/CsrAssembly.hpp"
-#include "structure/MembraneMeshImport.hpp"
+#include "structure/membrane/MembraneMeshImport.hpp"
 
 #include <array>
 #include <string>

@@ -7,7 +7,7 @@
 
 #include "core/BlockMesh.hpp"
 #include "core/Error.hpp"
-#include "structure/MembraneSolver.hpp"
+#include "structure/membrane/MembraneSolver.hpp"
 
 #include <gtest/gtest.h>
 

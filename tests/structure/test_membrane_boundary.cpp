@@ -9,7 +9,7 @@
 //  - corner springs balance distributed nodal forces.
 #include "support/Approx.hpp"
 
-#include "structure/MembraneSolver.hpp"
+#include "structure/membrane/MembraneSolver.hpp"
 
 #include <cmath>
 #include <random>

@@ -8,7 +8,7 @@
 //  - Rayleigh damping: logarithmic decrement against 2 pi zeta, zeta = alpha/(2 w) + beta w/2.
 #include "support/Approx.hpp"
 
-#include "structure/MembraneSolver.hpp"
+#include "structure/membrane/MembraneSolver.hpp"
 
 #include <Eigen/Dense>
 

@@ -5,7 +5,7 @@
 // initial normal; at p a/(E h) = 1e-5 the centre slope terms it neglects are ~ 1e-4 relative.
 #include "support/Approx.hpp"
 
-#include "structure/MembraneSolver.hpp"
+#include "structure/membrane/MembraneSolver.hpp"
 
 #include <cmath>
 #include <fstream>

@@ -7,8 +7,8 @@
 
 #include "core/BlockMesh.hpp"
 #include "core/Error.hpp"
-#include "structure/MembraneMeshImport.hpp"
-#include "structure/MembraneSolver.hpp"
+#include "structure/membrane/MembraneMeshImport.hpp"
+#include "structure/membrane/MembraneSolver.hpp"
 
 #include <Eigen/Dense>
 

@@ -8,7 +8,7 @@
 // (closed surface), so Newton must converge quadratically.
 #include "support/Approx.hpp"
 
-#include "structure/MembraneSolver.hpp"
+#include "structure/membrane/MembraneSolver.hpp"
 
 #include <cmath>
 

@@ -8,7 +8,7 @@
 //  - the no-atomics gathers vs serial host sums, and bitwise repeatability.
 #include "support/Approx.hpp"
 
-#include "structure/MembraneSolver.hpp"
+#include "structure/membrane/MembraneSolver.hpp"
 
 #include <Eigen/Dense>
 

@@ -4,7 +4,7 @@
 // S = C E + T0/h I in every element, whatever the element shapes. Quads and triangles.
 #include "support/Approx.hpp"
 
-#include "structure/MembraneSolver.hpp"
+#include "structure/membrane/MembraneSolver.hpp"
 
 #include <Eigen/Dense>
 

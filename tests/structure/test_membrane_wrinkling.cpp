@@ -11,7 +11,7 @@
 //    predicts the drop of the hub torque.
 #include "support/Approx.hpp"
 
-#include "structure/MembraneSolver.hpp"
+#include "structure/membrane/MembraneSolver.hpp"
 
 #include <Eigen/Dense>
 

@@ -1,9 +1,9 @@
-// Rigid multi-body frame dynamics (structure/RigidBodySystem): every test compares against an
+// Rigid multi-body frame dynamics (structure/rigid/RigidBodySystem): every test compares against an
 // analytic solution (damped oscillator, pendulum period, bead on a rotating rod, free fall, ...)
 // or an exact conservation law.
 #include "core/Error.hpp"
-#include "structure/RigidBodySystem.hpp"
-#include "structure/RigidCsvWriter.hpp"
+#include "structure/rigid/RigidBodySystem.hpp"
+#include "structure/rigid/RigidCsvWriter.hpp"
 #include "support/Approx.hpp"
 
 #include <algorithm>

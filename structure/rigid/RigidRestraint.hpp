@@ -4,8 +4,8 @@
 /// "restraints"): linear springs with axial damping to a world anchor, linear and angular dampers.
 /// They turn the current kinematics into body loads. (Prescribed rotations are constraints and are
 /// handled by `RigidBodySystem`.)
-#include "structure/RigidBodyModel.hpp"
-#include "structure/RigidOptions.hpp"
+#include "structure/rigid/RigidBodyModel.hpp"
+#include "structure/rigid/RigidOptions.hpp"
 
 #include <map>
 #include <string>

@@ -1,7 +1,7 @@
-#include "structure/MembraneConfig.hpp"
+#include "structure/membrane/MembraneConfig.hpp"
 
 #include "core/Suggest.hpp"
-#include "structure/MembraneMeshImport.hpp"
+#include "structure/membrane/MembraneMeshImport.hpp"
 
 #include <filesystem>
 

@@ -1,4 +1,4 @@
-#include "structure/MembraneSolver.hpp"
+#include "structure/membrane/MembraneSolver.hpp"
 
 #include "core/Error.hpp"
 #include "core/Timers.hpp"

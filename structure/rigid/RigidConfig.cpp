@@ -1,4 +1,4 @@
-#include "structure/RigidConfig.hpp"
+#include "structure/rigid/RigidConfig.hpp"
 
 namespace mfsi {
 

@@ -17,7 +17,7 @@
 ///     spring: {type: linearSpring, body: arm, anchor: [0, -2, 0], attachment: [0, -1, 0], stiffness: 100}
 /// \endcode
 #include "core/SceneConfig.hpp"
-#include "structure/RigidOptions.hpp"
+#include "structure/rigid/RigidOptions.hpp"
 
 namespace mfsi {
 

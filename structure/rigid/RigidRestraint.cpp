@@ -1,4 +1,4 @@
-#include "structure/RigidRestraint.hpp"
+#include "structure/rigid/RigidRestraint.hpp"
 
 #include "core/Error.hpp"
 

@@ -2,7 +2,7 @@
 /// \file
 /// \brief Per-step CSV report of a rigid body system: the header once, then one line per body
 /// per call (time, CoM, Euler angles, rotation matrix, velocities, accelerations, loads).
-#include "structure/RigidBodySystem.hpp"
+#include "structure/rigid/RigidBodySystem.hpp"
 
 #include <ostream>
 

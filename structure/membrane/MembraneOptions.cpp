@@ -1,4 +1,4 @@
-#include "structure/MembraneOptions.hpp"
+#include "structure/membrane/MembraneOptions.hpp"
 
 #include "core/Error.hpp"
 

@@ -3,7 +3,7 @@
 /// \brief Plain option structs of the membrane solver (filled by a configuration layer; no YAML
 /// here): material and wrinkling, static solvers, dynamics, loads, boundary conditions and
 /// reinforcements.
-#include "structure/MembraneMaterial.hpp"
+#include "structure/membrane/MembraneMaterial.hpp"
 
 #include <array>
 #include <functional>

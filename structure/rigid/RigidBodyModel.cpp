@@ -1,4 +1,4 @@
-#include "structure/RigidBodyModel.hpp"
+#include "structure/rigid/RigidBodyModel.hpp"
 
 #include "core/Error.hpp"
 

@@ -1,4 +1,4 @@
-#include "structure/MembraneMeshImport.hpp"
+#include "structure/membrane/MembraneMeshImport.hpp"
 
 #include "core/Error.hpp"
 #include "core/GmshText.hpp"

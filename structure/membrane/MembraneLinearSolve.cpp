@@ -1,4 +1,4 @@
-#include "structure/MembraneLinearSolve.hpp"
+#include "structure/membrane/MembraneLinearSolve.hpp"
 
 #include <cmath>
 

@@ -1,4 +1,4 @@
-#include "structure/MembraneMesh.hpp"
+#include "structure/membrane/MembraneMesh.hpp"
 
 #include "core/Error.hpp"
 

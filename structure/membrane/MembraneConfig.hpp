@@ -18,8 +18,8 @@
 /// \endcode
 #include "core/HexMesh.hpp"
 #include "core/SceneConfig.hpp"
-#include "structure/MembraneMesh.hpp"
-#include "structure/MembraneOptions.hpp"
+#include "structure/membrane/MembraneMesh.hpp"
+#include "structure/membrane/MembraneOptions.hpp"
 
 #include <string>
 #include <vector>

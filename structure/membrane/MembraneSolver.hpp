@@ -18,8 +18,8 @@
 /// \endcode
 ///
 /// State vectors are flat device Views with 3 entries per node (x, y, z).
-#include "structure/MembraneElements.hpp"
-#include "structure/MembraneLinearSolve.hpp"
+#include "structure/membrane/MembraneElements.hpp"
+#include "structure/membrane/MembraneLinearSolve.hpp"
 
 #include <map>
 #include <string>

@@ -14,9 +14,9 @@
 ///   K_AB = int B_A^T (h C_t) B_B dA0  +  int (dN_A/ds_a N_ab dN_B/ds_b) dA0 I,
 /// B_A the rows {dN_A,1 g_1; dN_A,2 g_2; dN_A,1 g_2 + dN_A,2 g_1}. Quads use 2 x 2 Gauss points
 /// (exact for the pressure terms), triangles one (constant strain).
-#include "structure/MembraneMesh.hpp"
-#include "structure/MembraneOptions.hpp"
-#include "structure/MembraneWrinkling.hpp"
+#include "structure/membrane/MembraneMesh.hpp"
+#include "structure/membrane/MembraneOptions.hpp"
+#include "structure/membrane/MembraneWrinkling.hpp"
 
 namespace mfsi {
 

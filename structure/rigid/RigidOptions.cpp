@@ -1,4 +1,4 @@
-#include "structure/RigidOptions.hpp"
+#include "structure/rigid/RigidOptions.hpp"
 
 #include "core/Error.hpp"
 

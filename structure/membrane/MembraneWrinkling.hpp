@@ -20,7 +20,7 @@
 /// at all, which makes the Newton matrix singular; the safeguard adds `eta E (m(x)m)(x)(m(x)m)`
 /// (wrinkled) or `eta C` (slack) to the tangent only. The stress, hence the converged answer, is
 /// unchanged; Newton stays quadratic in taut regions and nearly so elsewhere.
-#include "structure/MembraneMaterial.hpp"
+#include "structure/membrane/MembraneMaterial.hpp"
 
 namespace mfsi::membrane {
 

@@ -1,4 +1,4 @@
-#include "structure/RigidBodySystem.hpp"
+#include "structure/rigid/RigidBodySystem.hpp"
 
 #include "core/Error.hpp"
 

@@ -1,4 +1,4 @@
-#include "structure/RigidJoint.hpp"
+#include "structure/rigid/RigidJoint.hpp"
 
 #include "core/Error.hpp"
 

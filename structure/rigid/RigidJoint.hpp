@@ -2,7 +2,7 @@
 /// \file
 /// \brief Kinematics of one joint frame: how an elementary axis (Px ... Rz) or a fixed offset moves
 /// a frame, propagating position, orientation, velocity and acceleration from parent to child.
-#include "structure/RigidOptions.hpp"
+#include "structure/rigid/RigidOptions.hpp"
 
 #include <Eigen/Dense>
 

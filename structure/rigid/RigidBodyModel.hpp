@@ -6,8 +6,8 @@
 /// Design: a frame model is a handful of bodies, so the equations are assembled directly from
 /// body Jacobians (Kane's method) with dense Eigen algebra instead of Featherstone's recursive
 /// spatial-vector algorithms: simpler to verify, and O(n^2) in bodies is irrelevant at this size.
-#include "structure/RigidJoint.hpp"
-#include "structure/RigidOptions.hpp"
+#include "structure/rigid/RigidJoint.hpp"
+#include "structure/rigid/RigidOptions.hpp"
 
 #include <Eigen/Dense>
 

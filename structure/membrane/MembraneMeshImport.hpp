@@ -5,7 +5,7 @@
 /// ASCII surface meshes of quadrangles and/or triangles. Both fill a `MembraneMeshInput`; turn
 /// it into a mesh with `buildMembraneMesh`.
 #include "core/HexMesh.hpp"
-#include "structure/MembraneMesh.hpp"
+#include "structure/membrane/MembraneMesh.hpp"
 
 #include <string>
 #include <vector>

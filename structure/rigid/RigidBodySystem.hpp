@@ -15,9 +15,9 @@
 ///   qdot1 = qdot0 + d dt ((1 - gamma) a0 + gamma a1)
 ///   M(q1) a1 = Q(t1, q1, qdot1)      solved for a1 by Newton (FD Jacobian) or fixed point,
 /// then a1 <- r a1 + (1 - r) a_prev (r = accelerationRelaxation) and q1, qdot1 are recomputed.
-#include "structure/RigidBodyModel.hpp"
-#include "structure/RigidOptions.hpp"
-#include "structure/RigidRestraint.hpp"
+#include "structure/rigid/RigidBodyModel.hpp"
+#include "structure/rigid/RigidOptions.hpp"
+#include "structure/rigid/RigidRestraint.hpp"
 
 #include <Eigen/Dense>
 

@@ -1,4 +1,4 @@
-#include "structure/MembraneElements.hpp"
+#include "structure/membrane/MembraneElements.hpp"
 
 #include "core/Error.hpp"
 
