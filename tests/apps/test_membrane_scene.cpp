@@ -209,3 +209,32 @@ membranes:
   EXPECT_NE(msg.find("did you mean 'sail'"), std::string::npos) << msg;
   EXPECT_NE(msg.find("membranes.0.mesh.baffles.patch"), std::string::npos) << msg;
 }
+
+TEST(MembraneScene, ClampedStripUnderPressureIsTheExactCircularArc) {
+  // A strip clamped at x = 0 and 1 that stays in its (x, z) planes (the membrane of a 2D FSI scene),
+  // under a uniform follower pressure p: a circular arc of radius R and half-angle theta with
+  // L / 2 = R sin theta, stretch lambda = theta / sin theta, and the tension of St. Venant-Kirchhoff
+  // per unit width, lambda E h (lambda^2 - 1) / 2, equal to p R. Deflections up to 0.27 L.
+  const double E = 250, h = 0.002, L = 1;
+  for (const double p : {0.01, 0.2}) {
+    double lo = 1e-6, hi = 1.5;
+    for (int i = 0; i < 200; ++i) {
+      const double th = 0.5 * (lo + hi), lam = th / std::sin(th), R = L / (2 * std::sin(th));
+      (lam * E * h * (lam * lam - 1) / 2 > p * R ? hi : lo) = th;
+    }
+    const double th = 0.5 * (lo + hi), R = L / (2 * std::sin(th)), exact = R * (1 - std::cos(th));
+    std::ostringstream y;
+    y << "membranes:\n"
+         "  - mesh: {rectangle: {size: [1.0, 0.05], cells: [64, 1]}}\n"
+         "    material: {E: 250, nu: 0, thickness: 0.002, density: 500}\n"
+         "    loads: {pressure: "
+      << p
+      << "}\n"
+         "    solver: {tolerance: 1.0e-10, loadSteps: 10}\n"
+         "    boundary: {clamp: [xmin, xmax], motionPlaneNormal: [0, 1, 0]}\n";
+    const auto r = runScene(y.str(), "strip.yaml", "strip");
+    const double w = r.metrics.at("membrane.centreDeflection");
+    std::printf("p = %.2f Pa: mid-point deflection %.6f, exact arc %.6f\n", p, w, exact);
+    EXPECT_TRUE(near(w, exact, Tol{0, 2e-4})) << "p = " << p;
+  }
+}
