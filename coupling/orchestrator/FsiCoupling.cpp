@@ -237,8 +237,15 @@ void FsiCoupling::moveMesh(const InterfaceVector& x) {
   }
   {
     ScopedTimer timer(timers_, "coupling.motion");
-    const coupling::MotionReport r = smoother_->move(exec_, geometry_);
+    coupling::MotionReport r;
+    {
+      ScopedTimer part(timers_, "coupling.motion.smoother");
+      r = smoother_->move(exec_, geometry_);
+      exec_.fence();
+    }
     last_.minScaledJacobian = std::min(last_.minScaledJacobian, r.minScaledJacobian);
+    last_.motionIterations += r.sweeps;
+    ScopedTimer part(timers_, "coupling.motion.fluidGeometry");
     fluid_->solver().moveMesh(mesh_.points());
     exec_.fence();
   }
@@ -359,12 +366,14 @@ void FsiCoupling::advance(const TimeState& t) {
 }
 
 std::vector<std::string> FsiCoupling::stepColumns() const {
-  return {"iterations", "displacementResidual", "forceResidual", "omega", "columns", "minScaledJacobian", "cutBacks"};
+  return {"iterations", "displacementResidual", "forceResidual", "omega",           "columns",
+          "minScaledJacobian", "cutBacks",        "motionIterations"};
 }
 
 void FsiCoupling::appendStepValues(std::vector<double>& v) const {
   v.insert(v.end(), {double(last_.iterations), last_.displacementResidual, last_.forceResidual, last_.omega,
-                     double(last_.columns), last_.minScaledJacobian, double(last_.cutBacks)});
+                     double(last_.columns), last_.minScaledJacobian, double(last_.cutBacks),
+                     double(last_.motionIterations)});
 }
 
 void FsiCoupling::addMetrics(std::map<std::string, double>& m) const {

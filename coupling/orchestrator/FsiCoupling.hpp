@@ -63,6 +63,7 @@ class FsiCoupling final : public Module {
     int columns = 0;                  ///< quasi-Newton columns of the last update
     double minScaledJacobian = 1;
     int cutBacks = 0;  ///< iterates the mesh could not follow, cut back towards the last good one
+    int motionIterations = 0;  ///< CG iterations (or Jacobi sweeps) of the step's mesh motions
   };
   const StepReport& lastStep() const { return last_; }
 
