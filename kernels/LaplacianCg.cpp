@@ -45,17 +45,6 @@ void allocate(LaplacianCgWork& w, lid_t n) {
 
 }  // namespace
 
-void laplacianApply(const ExecSpace& exec, const SmoothingGraph& g, const ConstReal3View& x, const Real3View& y) {
-  const LaplacianRow row = rowOf(g);
-  const auto fixed = g.fixed;
-  Kokkos::parallel_for(
-      "mfsi::kernels::laplacianCg::apply", RangePolicy(exec, 0, g.nNodes()), KOKKOS_LAMBDA(lid_t i) {
-        real v[3] = {0, 0, 0};
-        if (fixed(i) == 0) row(x, i, v);
-        for (int c = 0; c < 3; ++c) y(i, c) = v[c];
-      });
-}
-
 LaplacianCgResult laplacianCg(const ExecSpace& exec, const SmoothingGraph& g, const Real3View& d, LaplacianCgWork& work,
                               const LaplacianCgOptions& options) {
   const lid_t n = g.nNodes();

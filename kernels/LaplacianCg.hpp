@@ -39,7 +39,4 @@ struct LaplacianCgWork {
 LaplacianCgResult laplacianCg(const ExecSpace& exec, const SmoothingGraph& g, const Real3View& d, LaplacianCgWork& work,
                               const LaplacianCgOptions& options);
 
-/// \brief y_i = sum_j w_ij (x_i - x_j) on free nodes, 0 on fixed nodes (one pass, no fence).
-void laplacianApply(const ExecSpace& exec, const SmoothingGraph& g, const ConstReal3View& x, const Real3View& y);
-
 }  // namespace mfsi

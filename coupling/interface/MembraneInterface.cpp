@@ -1,6 +1,7 @@
 #include "coupling/interface/MembraneInterface.hpp"
 
 #include "core/Error.hpp"
+#include "kernels/Blas.hpp"
 
 #include <algorithm>
 #include <map>
@@ -50,16 +51,11 @@ void interfacePressure(const ExecSpace& exec, const MembraneInterface& iface, co
 std::array<double, 3> interfaceForce(const ExecSpace& exec, const MembraneInterface& iface, lid_t nInternalFaces,
                                      const ConstReal3View& faceArea, const ConstRealView& elementPressure) {
   const ConstIndexView front = iface.front;
-  std::array<double, 3> F{0, 0, 0};
-  for (int k = 0; k < 3; ++k) {
-    double s = 0;
-    Kokkos::parallel_reduce(
-        "mfsi::coupling::interface::force", RangePolicy(exec, 0, iface.nElements()),
-        KOKKOS_LAMBDA(lid_t e, double& acc) { acc += elementPressure(e) * faceArea(front(e) + nInternalFaces, k); },
-        s);
-    F[k] = s;
-  }
-  return F;
+  return blas::reduce<3>(exec, SolverComm{}, "mfsi::coupling::interface::force", iface.nElements(),
+                         KOKKOS_LAMBDA(lid_t e, blas::Sums<3> & acc) {
+                           for (int k = 0; k < 3; ++k)
+                             acc[k] += elementPressure(e) * faceArea(front(e) + nInternalFaces, k);
+                         });
 }
 
 void interfaceViscousForce(const ExecSpace& exec, const MembraneInterface& iface, const NodeItemMap& nodeElements,

@@ -83,6 +83,7 @@ FsiCoupling::FsiCoupling(const CouplingOptions& options, const SceneConfig& sect
     p.load = RealView("mfsi::coupling::load", mm.nElements());
     p.loadPrevious = RealView("mfsi::coupling::loadPrevious", mm.nElements());
     p.faceVelocity = Real3View("mfsi::coupling::faceVelocity", mm.nElements());
+    p.iterate = RealView("mfsi::coupling::iterate", 3 * mm.nNodes());
     if (options_.pNetSmoothIter > 0) {
       p.graph = coupling::elementGraph(mm.hostElements(), mm.elementAreas());
       p.smoothWork = RealView("mfsi::coupling::smoothWork", mm.nElements());
@@ -212,9 +213,8 @@ void FsiCoupling::setTrial(const InterfaceVector& x) {
   for (Panel& p : panels_) {
     MembraneSolver& s = p.module->solver();
     if (p.dynamic) {
-      RealView u("mfsi::coupling::relaxed", 3 * s.mesh().nNodes());
-      toDevice(x, p.offset, u);
-      s.setTrialDisplacement(u);
+      toDevice(x, p.offset, p.iterate);
+      s.setTrialDisplacement(p.iterate);
     } else {
       toDevice(x, p.offset, s.displacement());
     }
@@ -230,9 +230,8 @@ void FsiCoupling::moveMesh(const InterfaceVector& x) {
   {
     ScopedTimer timer(timers_, "coupling.transfer");
     for (Panel& p : panels_) {
-      RealView u("mfsi::coupling::meshDisplacement", p.iface.nNodes() * 3);
-      toDevice(x, p.offset, u);
-      coupling::interfaceDisplacement(exec_, p.iface, u, smoother_->displacement());
+      toDevice(x, p.offset, p.iterate);
+      coupling::interfaceDisplacement(exec_, p.iface, p.iterate, smoother_->displacement());
     }
   }
   {

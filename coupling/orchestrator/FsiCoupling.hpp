@@ -81,6 +81,7 @@ class FsiCoupling final : public Module {
     Real3View tractionFront, tractionBack, pressureTraction;  ///< per face, work of boundaryTraction
     std::string frontPatch, backPatch;  ///< fluid patch names of the faces (back: baffle only)
     Real3View faceVelocity;
+    RealView iterate;  ///< this panel's slice of an interface iterate on the device (3 per node)
     Eigen::Index offset = 0;
     coupling::ElementGraph graph;  ///< pNetSmoothIter
     RealView smoothWork;
