@@ -31,10 +31,18 @@ int HexMesh::findPatch(const std::string& name) const {
 int HexMesh::patchIndex(const std::string& name) const {
   const int i = findPatch(name);
   if (i >= 0) return i;
+  throw InputError(source_ + ": " + noPatchMessage(name));
+}
+
+std::vector<std::string> HexMesh::patchNames() const {
   std::vector<std::string> names;
   for (const auto& p : patches_) names.push_back(p.name);
-  throw InputError(source_ + ": no patch named '" + name + "'" + didYouMean(name, names) +
-                   "; patches are: " + joinList(names));
+  return names;
+}
+
+std::string HexMesh::noPatchMessage(const std::string& name) const {
+  const std::vector<std::string> names = patchNames();
+  return "the mesh has no patch '" + name + "'" + didYouMean(name, names) + "; patches: " + joinList(names);
 }
 
 void HexMesh::resetPoints() const { Kokkos::deep_copy(points_, points0_); }

@@ -113,6 +113,11 @@ class HexMesh {
   int findPatch(const std::string& name) const;
   /// Index of the patch with that name; throws InputError listing the patches (and a close match).
   int patchIndex(const std::string& name) const;
+  /// The patch names, in patch order.
+  std::vector<std::string> patchNames() const;
+  /// "the mesh has no patch 'name'; did you mean '...'?; patches: a, b, c": for an InputError of a
+  /// config layer, which adds the file, line and key.
+  std::string noPatchMessage(const std::string& name) const;
   const std::string& source() const { return source_; }
 
   /// Put the nodes back at their reference positions.

@@ -12,8 +12,12 @@ RigidModule::RigidModule(const RigidSystemOptions& options) : Module("bodies"), 
 
 void RigidModule::advance(const TimeState& t) {
   system_.step(t.time, t.dt);
+  recordStep();
+}
+
+void RigidModule::recordStep() {
   const double e = system_.kineticEnergy() + system_.potentialEnergy();
-  if (!std::isfinite(e)) throw DivergenceError("rigid bodies: non-finite energy at t = " + std::to_string(t.time + t.dt));
+  if (!std::isfinite(e)) throw DivergenceError("rigid bodies: non-finite energy at t = " + std::to_string(system_.time()));
   maxEnergyDrift_ = std::max(maxEnergyDrift_, std::abs(e - energy0_));
   if (csv_.is_open()) system_.writeCsvRows(csv_);
 }

@@ -18,6 +18,8 @@ class RigidModule final : public Module {
   void appendStepValues(std::vector<double>& values) const override;
 
   RigidBodySystem& system() { return system_; }
+  /// After a committed step (advance, or the coupling's commit): energy drift and bodies.csv.
+  void recordStep();
 
  private:
   RigidBodySystem system_;

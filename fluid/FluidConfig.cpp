@@ -341,12 +341,8 @@ FluidReports readFluidReports(const SceneConfig& c, const HexMesh& mesh, const F
     pr.from = vec3(p, "from");
     pr.to = vec3(p, "to");
     pr.patch = p.get<std::string>("patch");
-    if (!pr.patch.empty() && mesh.findPatch(pr.patch) < 0) {
-      std::vector<std::string> names;
-      for (const auto& mp : mesh.patches()) names.push_back(mp.name);
-      throw InputError(p.where("patch"),
-                       "the mesh has no patch named '" + pr.patch + "'" + didYouMean(pr.patch, names));
-    }
+    if (!pr.patch.empty() && mesh.findPatch(pr.patch) < 0)
+      throw InputError(p.where("patch"), mesh.noPatchMessage(pr.patch));
     r.pressureDifferences.push_back(pr);
   }
   if (c.has("ghia") && c.get<bool>("ghia.enabled")) {

@@ -101,7 +101,13 @@ Schema couplingSchema() {
            Schema::boolean("load the membranes with the fluid's viscous traction too (nodal forces), not the "
                            "pressure alone"),
            Default(o.viscousTraction))
-      .key("meshMotion", motion, Presence::Optional);
+      .key("meshMotion", motion, Presence::Optional)
+      .key("bodyPatches",
+           Schema::freeMap("rigid bodies of the `bodies` section coupled with the fluid: body name -> the fluid "
+                           "patches it carries (movingWall patches; their nodes follow the body rigidly, the fluid's "
+                           "force and moment on them load the body)",
+                           Schema::list("fluid patches of the body", Schema::string("patch name"))),
+           Presence::Optional);
 }
 
 CouplingOptions readCouplingOptions(const SceneConfig& c) {
@@ -145,6 +151,8 @@ CouplingOptions readCouplingOptions(const SceneConfig& c) {
   o.motion.minScaledJacobian = c.get<double>("meshMotion.minScaledJacobian");
   o.motion.retries = c.get<int>("meshMotion.retries");
   o.motion.slidingPatches = c.get<std::vector<std::string>>("meshMotion.slidingPatches");
+  for (const auto& name : c.keys("bodyPatches"))
+    o.bodyPatches.push_back({name, c.get<std::vector<std::string>>("bodyPatches." + name)});
   return o;
 }
 

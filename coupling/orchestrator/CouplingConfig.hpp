@@ -20,6 +20,7 @@
 ///   fsiRampTime: 0          # load ramp 0 -> 100 % after fsiStartTime
 ///   outsidePressure: 0      # pressure behind a membrane that replaces a wall patch
 ///   meshMotion: {sweeps: 50, minScaledJacobian: 0.05}
+///   bodyPatches: {piston: [pistonFace]}   # rigid bodies (the `bodies` section) and the fluid patches they carry
 /// \endcode
 #include "core/SceneConfig.hpp"
 #include "coupling/acceleration/Acceleration.hpp"
@@ -55,6 +56,12 @@ struct CouplingOptions {
   double outsidePressure = 0; ///< Pa
   bool viscousTraction = false;  ///< add the fluid's viscous traction to the membrane loads
   coupling::MeshSmootherOptions motion;
+  /// \brief A rigid body of the `bodies` section and the fluid patches that move with it.
+  struct BodyPatches {
+    std::string body;
+    std::vector<std::string> patches;
+  };
+  std::vector<BodyPatches> bodyPatches;  ///< empty: no body is coupled
 };
 
 /// Schema of the `coupling` section.

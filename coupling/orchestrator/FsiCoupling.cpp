@@ -36,18 +36,19 @@ void toDevice(const InterfaceVector& x, Eigen::Index offset, const RealView& d) 
 
 FsiCoupling::FsiCoupling(const CouplingOptions& options, const SceneConfig& section, HexMesh& mesh,
                          MeshGeometry& geometry, Timers& timers, std::unique_ptr<FluidModule> fluid,
-                         std::vector<std::unique_ptr<MembraneModule>> membranes)
+                         std::vector<std::unique_ptr<MembraneModule>> membranes, std::unique_ptr<RigidModule> rigid)
     : Module("coupling"),
       options_(options),
       mesh_(mesh),
       geometry_(geometry),
       timers_(timers),
       fluid_(std::move(fluid)),
-      ownedMembranes_(std::move(membranes)) {
+      ownedMembranes_(std::move(membranes)),
+      rigid_(std::move(rigid)) {
   MFSI_CHECK(fluid_, "coupling: no fluid module");
-  if (ownedMembranes_.empty())
+  if (ownedMembranes_.empty() && options_.bodyPatches.empty())
     throw InputError(section.where(), "the coupling needs at least one membrane cut from the fluid mesh "
-                                      "(membranes.N.mesh: baffles or boundaryPatch)");
+                                      "(membranes.N.mesh: baffles or boundaryPatch) or a rigid body (bodyPatches)");
   const fluid::BoundaryConditions& bc = fluid_->solver().boundaryConditions();
   std::vector<coupling::InterfaceBlock> layout;
   for (auto& m : ownedMembranes_) {
@@ -107,20 +108,63 @@ FsiCoupling::FsiCoupling(const CouplingOptions& options, const SceneConfig& sect
   }
   for (std::size_t i = 0; i < options_.motion.slidingPatches.size(); ++i) {
     const std::string& s = options_.motion.slidingPatches[i];
-    if (mesh_.findPatch(s) < 0) {
-      std::vector<std::string> names;
-      for (const auto& pt : mesh_.patches()) names.push_back(pt.name);
-      throw InputError(section.where("meshMotion.slidingPatches." + std::to_string(i)),
-                       "the mesh has no patch '" + s + "'" + didYouMean(s, names) + "; patches: " + joinList(names));
-    }
+    if (mesh_.findPatch(s) < 0)
+      throw InputError(section.where("meshMotion.slidingPatches." + std::to_string(i)), mesh_.noPatchMessage(s));
   }
+  setUpBodies(section, layout);
   smoother_ = std::make_unique<coupling::MeshSmoother>(mesh_, options_.motion);
   acceleration_ = coupling::makeAcceleration(options_.acceleration, layout);
+}
+
+void FsiCoupling::setUpBodies(const SceneConfig& section, std::vector<coupling::InterfaceBlock>& layout) {
+  if (options_.bodyPatches.empty()) return;
+  if (!rigid_) throw InputError(section.where("bodyPatches"), "bodyPatches needs the scene's 'bodies' section");
+  if (options_.fsiStartTime > 0)
+    throw InputError(section.where("fsiStartTime"),
+                     "fsiStartTime > 0 with coupled rigid bodies is not supported yet (freeze a body with "
+                     "bodies.newmark.accelerationDamping = 0 instead)");
+  const RigidBodySystem& sys = rigid_->system();
+  if (sys.nDof() == 0)
+    throw InputError(section.where("bodyPatches"), "the coupled bodies have no free coordinate (every joint is fixed)");
+  std::vector<std::string> bodyNames;
+  for (int b = 0; b < sys.nBodies(); ++b) bodyNames.push_back(sys.model().bodyName(b));
+  RigidTreeKinematics kin;
+  sys.model().kinematics(sys.time(), sys.q(), sys.qdot(), sys.qddot(), kin);
+  const fluid::BoundaryConditions& bc = fluid_->solver().boundaryConditions();
+  for (const auto& bp : options_.bodyPatches) {
+    const std::string key = "bodyPatches." + bp.body;
+    if (std::find(bodyNames.begin(), bodyNames.end(), bp.body) == bodyNames.end())
+      throw InputError(section.where(key), "the bodies section has no body '" + bp.body + "'" +
+                                               didYouMean(bp.body, bodyNames) + "; bodies: " + joinList(bodyNames));
+    CoupledBody b;
+    b.index = sys.bodyIndex(bp.body);
+    b.name = bp.body;
+    b.patches = bp.patches;
+    for (std::size_t i = 0; i < bp.patches.size(); ++i) {
+      const std::string& name = bp.patches[i];
+      const std::string at = key + "." + std::to_string(i);
+      if (mesh_.findPatch(name) < 0) throw InputError(section.where(at), mesh_.noPatchMessage(name));
+      for (int pi : bc.find(name)) {
+        const fluid::ResolvedPatch& rp = bc.patches()[pi];
+        if (rp.type != fluid::BoundaryType::Wall || rp.bc.wallMotion != fluid::WallMotion::MeshVelocity)
+          throw InputError(section.where(at), "fluid.boundary." + name + " moves with body " + bp.body +
+                                                  ": make it 'type: movingWall' (wall velocity from the mesh motion)");
+      }
+    }
+    b.motion = coupling::BodyPatchMotion(mesh_, bp.patches);
+    b.com0 = kin.bodies[b.index].com;
+    b.rotation0 = kin.bodies[b.index].frame.rotation;
+    bodies_.push_back(std::move(b));
+  }
+  bodyOffset_ = size_;
+  layout.push_back({"bodies", size_, sys.nDof()});
+  size_ += sys.nDof();
 }
 
 std::vector<Module*> FsiCoupling::parts() {
   std::vector<Module*> v{fluid_.get()};
   for (auto& m : ownedMembranes_) v.push_back(m.get());
+  if (rigid_) v.push_back(rigid_.get());
   return v;
 }
 
@@ -181,14 +225,42 @@ void FsiCoupling::updateLoads(double scale, bool relax, double dt) {
           for (int k = 0; k < 3; ++k) force(i, k) = w * force(i, k) + (1 - w) * fprev(i, k);
         });
   }
+  updateBodyLoads(scale);
   const SolverComm comm;
   change2 = comm.globalSum(change2);
   norm2 = comm.globalSum(norm2);
   forceResidual_ = norm2 > 0 ? std::sqrt(change2 / norm2) : (change2 > 0 ? 1.0 : 0.0);
 }
 
+void FsiCoupling::updateBodyLoads(double scale) {
+  if (bodies_.empty()) return;
+  const fluid::FluidSolver& f = fluid_->solver();
+  RigidBodySystem& sys = rigid_->system();
+  for (const CoupledBody& b : bodies_) {
+    // Force and moment about the body's centre of mass in its latest state.
+    const Eigen::Vector3d c = sys.bodyReport(b.index).position;
+    Eigen::Vector3d force = Eigen::Vector3d::Zero(), moment = Eigen::Vector3d::Zero();
+    for (const auto& patch : b.patches) {
+      const fluid::PatchLoads L = fluid::patchLoads(f, patch, {c[0], c[1], c[2]});
+      for (int k = 0; k < 3; ++k) {
+        force[k] += L.force[k];
+        moment[k] += L.moment[k];
+      }
+    }
+    sys.setExternalLoad(b.index, scale * force, scale * moment);
+  }
+}
+
 void FsiCoupling::solveStructure(double t1, double dt) {
   ScopedTimer timer(timers_, "coupling.structure");
+  if (!bodies_.empty()) {
+    RigidBodySystem& sys = rigid_->system();
+    try {
+      sys.solveStep(sys.time(), dt);
+    } catch (const DivergenceError& e) {
+      throw DivergenceError(std::string("bodies: the rigid step to t = ") + std::to_string(t1) + " failed: " + e.what());
+    }
+  }
   for (Panel& p : panels_) {
     MembraneSolver& s = p.module->solver();
     const MembraneSolveReport rep = p.dynamic ? s.solveStep(dt) : s.solveStatic(t1);
@@ -207,6 +279,7 @@ void FsiCoupling::gatherTrial(InterfaceVector& xt) const {
     MembraneSolver& s = p.module->solver();
     toHost(p.dynamic ? s.trialDisplacement() : s.displacement(), xt, p.offset);
   }
+  if (!bodies_.empty()) xt.segment(bodyOffset_, rigid_->system().nDof()) = rigid_->system().q();
 }
 
 void FsiCoupling::setTrial(const InterfaceVector& x) {
@@ -224,11 +297,36 @@ void FsiCoupling::setTrial(const InterfaceVector& x) {
 void FsiCoupling::commitStructure() {
   for (Panel& p : panels_)
     if (p.dynamic) p.module->solver().commitStep();
+  if (!bodies_.empty()) {
+    rigid_->system().commitStep();
+    rigid_->recordStep();
+  }
+}
+
+void FsiCoupling::placeBodies(const InterfaceVector& x) {
+  if (bodies_.empty()) return;
+  const RigidBodySystem& sys = rigid_->system();
+  const Eigen::Index n = sys.nDof();
+  const Eigen::VectorXd q = x.segment(bodyOffset_, n), zero = Eigen::VectorXd::Zero(n);
+  RigidTreeKinematics kin;
+  sys.model().kinematics(stepEnd_, q, zero, zero, kin);
+  for (const CoupledBody& b : bodies_) {
+    coupling::RigidTransform T;
+    const Eigen::Vector3d c = kin.bodies[b.index].com;
+    const Eigen::Matrix3d Q = kin.bodies[b.index].frame.rotation * b.rotation0.transpose();
+    for (int k = 0; k < 3; ++k) {
+      T.c0[k] = b.com0[k];
+      T.c[k] = c[k];
+      for (int j = 0; j < 3; ++j) T.Q[3 * k + j] = Q(k, j);
+    }
+    b.motion.apply(exec_, T, smoother_->displacement());
+  }
 }
 
 void FsiCoupling::moveMesh(const InterfaceVector& x) {
   {
     ScopedTimer timer(timers_, "coupling.transfer");
+    placeBodies(x);
     for (Panel& p : panels_) {
       toDevice(x, p.offset, p.iterate);
       coupling::interfaceDisplacement(exec_, p.iface, p.iterate, smoother_->displacement());
@@ -283,6 +381,7 @@ void FsiCoupling::solveFluid(const TimeState& t) {
 
 void FsiCoupling::advance(const TimeState& t) {
   const double t1 = t.time + t.dt;
+  stepEnd_ = t1;
   last_ = StepReport{};
   fluid_->beginStep(t);
   if (t1 <= options_.fsiStartTime + 1e-12 * std::max(1.0, std::abs(t1))) {
@@ -405,6 +504,8 @@ ModuleEntry couplingModuleEntry() {
               throw InputError(section.where(), "the coupling needs the scene's 'mesh' and 'fluid' sections");
             std::unique_ptr<FluidModule> fluid;
             std::vector<std::unique_ptr<MembraneModule>> membranes;
+            std::unique_ptr<RigidModule> rigid;
+            const CouplingOptions options = readCouplingOptions(section);
             std::vector<std::unique_ptr<Module>> rest;
             for (auto& m : *ctx.built) {
               if (auto* f = dynamic_cast<FluidModule*>(m.get())) {
@@ -415,15 +516,17 @@ ModuleEntry couplingModuleEntry() {
                                            mm->panel().mesh.kind == MembraneMeshKind::Patch)) {
                 membranes.emplace_back(mm);
                 m.release();
+              } else if (auto* r = dynamic_cast<RigidModule*>(m.get()); r != nullptr && !options.bodyPatches.empty()) {
+                rigid.reset(r);
+                m.release();
               } else {
                 rest.push_back(std::move(m));
               }
             }
             *ctx.built = std::move(rest);
             if (!fluid) throw InputError(section.where(), "the coupling needs the scene's 'fluid' section");
-            out.push_back(std::make_unique<FsiCoupling>(readCouplingOptions(section), section, *ctx.mesh,
-                                                        *ctx.geometry, *ctx.timers, std::move(fluid),
-                                                        std::move(membranes)));
+            out.push_back(std::make_unique<FsiCoupling>(options, section, *ctx.mesh, *ctx.geometry, *ctx.timers,
+                                                        std::move(fluid), std::move(membranes), std::move(rigid)));
             return out;
           }};
 }

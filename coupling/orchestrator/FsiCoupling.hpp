@@ -19,11 +19,18 @@
 /// per step, each followed by a structure solve, as peers count coupling iterations (the
 /// predictor makes structure solves = iterations + 1).
 ///
+/// Rigid bodies (`bodyPatches`) take part like membranes: their free coordinates q are a block of
+/// the interface vector, their fluid patches move with them (the interior by the mesh motion), and
+/// the fluid's force and moment on those patches load them; every iteration re-solves their step
+/// from the committed state (RigidBodySystem::solveStep), the step commits once.
+///
 /// Membrane state never leaks from one iteration into the next: a dynamic membrane re-solves the
 /// step from its committed state (MembraneSolver::solveStep) and commits once; the fluid re-solves
 /// the step from its current iterate on the moved mesh, its time levels set at beginStep.
 #include "coupling/FluidModule.hpp"
 #include "coupling/MembraneModule.hpp"
+#include "coupling/RigidModule.hpp"
+#include "coupling/motion/BodyPatchMotion.hpp"
 #include "coupling/interface/MembraneInterface.hpp"
 #include "coupling/motion/MeshSmoother.hpp"
 #include "coupling/orchestrator/CouplingConfig.hpp"
@@ -35,12 +42,14 @@ namespace mfsi {
 
 class FsiCoupling final : public Module {
  public:
-  /// Couples `fluid` with every membrane in `membranes` (each cut from the fluid mesh). The mesh and
-  /// its geometry (the scene's) must outlive the module. Throws InputError naming the section for
-  /// membranes that are not on the fluid mesh or fluid walls that cannot follow them.
+  /// Couples `fluid` with every membrane in `membranes` (each cut from the fluid mesh) and with the
+  /// bodies of `rigid` that options.bodyPatches names (rigid may be null without bodyPatches). The
+  /// mesh and its geometry (the scene's) must outlive the module. Throws InputError naming the
+  /// section for membranes that are not on the fluid mesh, unknown bodies or patches, or fluid
+  /// walls that cannot follow them.
   FsiCoupling(const CouplingOptions& options, const SceneConfig& section, HexMesh& mesh, MeshGeometry& geometry,
               Timers& timers, std::unique_ptr<FluidModule> fluid,
-              std::vector<std::unique_ptr<MembraneModule>> membranes);
+              std::vector<std::unique_ptr<MembraneModule>> membranes, std::unique_ptr<RigidModule> rigid = nullptr);
 
   void advance(const TimeState& t) override;
   void addMetrics(std::map<std::string, double>& metrics) const override;
@@ -88,15 +97,28 @@ class FsiCoupling final : public Module {
     RealView filtered;             ///< pNetFilterTau: the filtered load of the last step
     bool haveFiltered = false;
   };
+  /// A rigid body of the coupling and the fluid patches it carries.
+  struct CoupledBody {
+    int index = -1;
+    std::string name;
+    std::vector<std::string> patches;
+    coupling::BodyPatchMotion motion;
+    Eigen::Vector3d com0 = Eigen::Vector3d::Zero();      ///< centre of mass at the start (the mesh's configuration)
+    Eigen::Matrix3d rotation0 = Eigen::Matrix3d::Identity();
+  };
   /// Membrane loads from the fluid (times `scale`); with `relax`, forceOmega-blended with the
   /// previous ones. Sets the load residual.
   void updateLoads(double scale, bool relax, double dt);
   /// The filter state of pNetFilterTau advances to the step's last load.
   void advanceLoadFilter();
+  /// The fluid's force and moment on each coupled body's patches (times `scale`) become its external load.
+  void updateBodyLoads(double scale);
   void solveStructure(double t1, double dt);
   void gatherTrial(coupling::InterfaceVector& xt) const;
   void setTrial(const coupling::InterfaceVector& x);
   void commitStructure();
+  /// Coupled bodies' patch nodes to the poses of the coordinates in x (the mesh motion's prescribed displacements).
+  void placeBodies(const coupling::InterfaceVector& x);
   void moveMesh(const coupling::InterfaceVector& x);
   /// moveMesh(x), or, when the mesh cannot follow x (a cell would invert), the largest step from
   /// `good` towards x that it can follow (halved up to 6 times; x is overwritten); then `good` = x.
@@ -106,6 +128,7 @@ class FsiCoupling final : public Module {
   double loadScale(double t1) const;
 
  private:
+  void setUpBodies(const SceneConfig& section, std::vector<coupling::InterfaceBlock>& layout);
 
   CouplingOptions options_;
   HexMesh& mesh_;
@@ -115,9 +138,13 @@ class FsiCoupling final : public Module {
   std::unique_ptr<FluidModule> fluid_;
   std::vector<std::unique_ptr<MembraneModule>> ownedMembranes_;
   std::vector<Panel> panels_;
+  std::unique_ptr<RigidModule> rigid_;
+  std::vector<CoupledBody> bodies_;
+  Eigen::Index bodyOffset_ = 0;  ///< the free coordinates of the rigid system in the interface vector
   std::unique_ptr<coupling::MeshSmoother> smoother_;
   std::unique_ptr<coupling::Acceleration> acceleration_;
   Eigen::Index size_ = 0;
+  double stepEnd_ = 0;  ///< t_n+1 of the step being solved
   double forceResidual_ = 0;
   StepReport last_;
   long long steps_ = 0, iterationsTotal_ = 0, unconvergedSteps_ = 0, unconvergedInARow_ = 0, cutBacksTotal_ = 0;

@@ -5,6 +5,7 @@
 //  - the explicit scheme makes one pass per step and lands elsewhere;
 //  - coupling input errors name the key; without a `coupling` section nothing is coupled.
 #include "support/Approx.hpp"
+#include "support/SceneErrors.hpp"
 
 #include "coupling/Module.hpp"
 #include "coupling/Simulation.hpp"
@@ -65,15 +66,7 @@ double interpolate(const std::string& file, double t) {
   return NAN;
 }
 
-std::string inputError(const std::vector<std::string>& sets) {
-  try {
-    auto cfg = mfsi::SceneConfig::load(kScene, mfsi::sceneSchema(), sets);
-    mfsi::Simulation sim(cfg);
-  } catch (const mfsi::InputError& e) {
-    return e.what();
-  }
-  return "";
-}
+std::string inputError(const std::vector<std::string>& sets) { return mfsi::test::sceneInputError(kScene, sets); }
 
 }  // namespace
 

@@ -1,0 +1,52 @@
+#include "coupling/motion/BodyPatchMotion.hpp"
+
+#include "core/Error.hpp"
+
+#include <algorithm>
+
+namespace mfsi::coupling {
+
+BodyPatchMotion::BodyPatchMotion(const HexMesh& mesh, const std::vector<std::string>& patches) {
+  auto fn = Kokkos::create_mirror_view_and_copy(HostSpace(), mesh.faceNodes());
+  for (const auto& name : patches) {
+    const int pi = mesh.findPatch(name);
+    MFSI_CHECK(pi >= 0, "body patch motion: no patch '" << name << "'");
+    const auto& patch = mesh.patches()[pi];
+    for (lid_t f = patch.start; f < patch.start + patch.size; ++f)
+      for (int a = 0; a < 4; ++a) hostNodes_.push_back(fn(f, a));
+  }
+  std::sort(hostNodes_.begin(), hostNodes_.end());
+  hostNodes_.erase(std::unique(hostNodes_.begin(), hostNodes_.end()), hostNodes_.end());
+  const lid_t n = static_cast<lid_t>(hostNodes_.size());
+  nodes_ = IndexView("mfsi::coupling::bodyPatch::nodes", n);
+  reference_ = Real3View("mfsi::coupling::bodyPatch::reference", n);
+  auto hn = Kokkos::create_mirror_view(nodes_);
+  auto hr = Kokkos::create_mirror_view(reference_);
+  auto pts = Kokkos::create_mirror_view_and_copy(HostSpace(), mesh.points());
+  for (lid_t i = 0; i < n; ++i) {
+    hn(i) = hostNodes_[i];
+    for (int k = 0; k < 3; ++k) hr(i, k) = pts(hostNodes_[i], k);
+  }
+  Kokkos::deep_copy(nodes_, hn);
+  Kokkos::deep_copy(reference_, hr);
+}
+
+void BodyPatchMotion::apply(const ExecSpace& exec, const RigidTransform& T, const Real3View& displacement) const {
+  const IndexView nodes = nodes_;
+  const Real3View X = reference_;
+  const Real3View d = displacement;
+  const real c00 = T.c0[0], c01 = T.c0[1], c02 = T.c0[2];
+  const real c0 = T.c[0], c1 = T.c[1], c2 = T.c[2];
+  const real q00 = T.Q[0], q01 = T.Q[1], q02 = T.Q[2], q10 = T.Q[3], q11 = T.Q[4], q12 = T.Q[5], q20 = T.Q[6],
+             q21 = T.Q[7], q22 = T.Q[8];
+  Kokkos::parallel_for(
+      "mfsi::coupling::bodyPatch::displacement", RangePolicy(exec, 0, nNodes()), KOKKOS_LAMBDA(lid_t i) {
+        const lid_t v = nodes(i);
+        const real r0 = X(i, 0) - c00, r1 = X(i, 1) - c01, r2 = X(i, 2) - c02;
+        d(v, 0) = c0 + q00 * r0 + q01 * r1 + q02 * r2 - X(i, 0);
+        d(v, 1) = c1 + q10 * r0 + q11 * r1 + q12 * r2 - X(i, 1);
+        d(v, 2) = c2 + q20 * r0 + q21 * r1 + q22 * r2 - X(i, 2);
+      });
+}
+
+}  // namespace mfsi::coupling

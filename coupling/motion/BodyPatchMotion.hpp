@@ -1,0 +1,46 @@
+#pragma once
+/// \file
+/// \brief The fluid-mesh nodes that move with a rigid body: the nodes of the fluid patches a body
+/// carries (`coupling.bodyPatches`), placed by the body's rigid transform.
+///
+/// The mesh is the body's start configuration: a node at reference position X sits at
+///   x = c + R R0^T (X - c0)
+/// with (c0, R0) the body's centre of mass and orientation at the start and (c, R) its current
+/// ones, so its displacement from the reference is x - X. Written into the mesh motion's
+/// prescribed displacements; the interior follows by the point-Laplacian.
+#include "core/HexMesh.hpp"
+
+#include <array>
+#include <string>
+#include <vector>
+
+namespace mfsi::coupling {
+
+/// \brief A rigid motion relative to the start configuration: x = c + Q (X - c0), Q = R R0^T.
+struct RigidTransform {
+  std::array<double, 3> c0{0, 0, 0};  ///< centre of mass at the start
+  std::array<double, 3> c{0, 0, 0};   ///< centre of mass now
+  std::array<double, 9> Q{1, 0, 0, 0, 1, 0, 0, 0, 1};  ///< row-major rotation from the start to now
+};
+
+class BodyPatchMotion {
+ public:
+  BodyPatchMotion() = default;
+  /// The nodes of every face of `patches` (each must exist; the caller names the key), with their
+  /// reference positions (the mesh's points now).
+  BodyPatchMotion(const HexMesh& mesh, const std::vector<std::string>& patches);
+
+  lid_t nNodes() const { return static_cast<lid_t>(nodes_.extent(0)); }
+  /// Node indices (host copy, sorted).
+  const std::vector<lid_t>& hostNodes() const { return hostNodes_; }
+
+  /// displacement(node) = c + Q (X - c0) - X for this body's nodes; other entries untouched.
+  void apply(const ExecSpace& exec, const RigidTransform& T, const Real3View& displacement) const;
+
+ private:
+  IndexView nodes_;
+  Real3View reference_;
+  std::vector<lid_t> hostNodes_;
+};
+
+}  // namespace mfsi::coupling
