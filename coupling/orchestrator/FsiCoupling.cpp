@@ -124,8 +124,6 @@ void FsiCoupling::setUpBodies(const SceneConfig& section, std::vector<coupling::
                      "fsiStartTime > 0 with coupled rigid bodies is not supported yet (freeze a body with "
                      "bodies.newmark.accelerationDamping = 0 instead)");
   const RigidBodySystem& sys = rigid_->system();
-  if (sys.nDof() == 0)
-    throw InputError(section.where("bodyPatches"), "the coupled bodies have no free coordinate (every joint is fixed)");
   std::vector<std::string> bodyNames;
   for (int b = 0; b < sys.nBodies(); ++b) bodyNames.push_back(sys.model().bodyName(b));
   RigidTreeKinematics kin;
@@ -156,8 +154,9 @@ void FsiCoupling::setUpBodies(const SceneConfig& section, std::vector<coupling::
     b.rotation0 = kin.bodies[b.index].frame.rotation;
     bodies_.push_back(std::move(b));
   }
+  // Bodies whose joints are all prescribed (or fixed) move the mesh without unknowns: one-way.
   bodyOffset_ = size_;
-  layout.push_back({"bodies", size_, sys.nDof()});
+  if (sys.nDof() > 0) layout.push_back({"bodies", size_, sys.nDof()});
   size_ += sys.nDof();
 }
 
