@@ -1,6 +1,6 @@
 // mfsi — the membrane-fsi command.
 //
-//   mfsi run                                  # the default scene, results in results/<scene>/
+//   mfsi run                                  # the default scene (membrane-channel), results in results/<scene>/
 //   mfsi run cases/box.yaml --out /tmp/box --threads 2
 //   mfsi run box --set mesh.blocks.0.cells=[32,32,8]
 //   mfsi check cases/box.yaml                 # validate without running (also builds the mesh)
@@ -24,7 +24,7 @@ namespace fs = std::filesystem;
 
 namespace {
 
-constexpr const char* kDefaultScene = "box";
+constexpr const char* kDefaultScene = "membrane-channel";
 
 std::vector<fs::path> caseDirs() {
   std::vector<fs::path> dirs;

@@ -9,11 +9,13 @@ namespace mfsi::coupling {
 BodyPatchMotion::BodyPatchMotion(const HexMesh& mesh, const std::vector<std::string>& patches) {
   auto fn = Kokkos::create_mirror_view_and_copy(HostSpace(), mesh.faceNodes());
   for (const auto& name : patches) {
-    const int pi = mesh.findPatch(name);
-    MFSI_CHECK(pi >= 0, "body patch motion: no patch '" << name << "'");
-    const auto& patch = mesh.patches()[pi];
-    for (lid_t f = patch.start; f < patch.start + patch.size; ++f)
-      for (int a = 0; a < 4; ++a) hostNodes_.push_back(fn(f, a));
+    const std::vector<int> indices = patchIndices(mesh, name);
+    MFSI_CHECK(!indices.empty(), "body patch motion: no patch or baffle '" << name << "'");
+    for (int pi : indices) {
+      const auto& patch = mesh.patches()[pi];
+      for (lid_t f = patch.start; f < patch.start + patch.size; ++f)
+        for (int a = 0; a < 4; ++a) hostNodes_.push_back(fn(f, a));
+    }
   }
   std::sort(hostNodes_.begin(), hostNodes_.end());
   hostNodes_.erase(std::unique(hostNodes_.begin(), hostNodes_.end()), hostNodes_.end());
@@ -29,6 +31,17 @@ BodyPatchMotion::BodyPatchMotion(const HexMesh& mesh, const std::vector<std::str
   }
   Kokkos::deep_copy(nodes_, hn);
   Kokkos::deep_copy(reference_, hr);
+}
+
+std::vector<int> BodyPatchMotion::patchIndices(const HexMesh& mesh, const std::string& name) {
+  const int pi = mesh.findPatch(name);
+  if (pi >= 0) return {pi};
+  std::vector<int> out;
+  for (const char* side : {"_master", "_slave"}) {
+    const int s = mesh.findPatch(name + side);
+    if (s >= 0) out.push_back(s);
+  }
+  return out;
 }
 
 void BodyPatchMotion::apply(const ExecSpace& exec, const RigidTransform& T, const Real3View& displacement) const {

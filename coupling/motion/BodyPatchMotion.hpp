@@ -30,6 +30,10 @@ class BodyPatchMotion {
   /// reference positions (the mesh's points now).
   BodyPatchMotion(const HexMesh& mesh, const std::vector<std::string>& patches);
 
+  /// Mesh patches a name stands for: the patch, or both sides of a baffle (<name>_master,
+  /// <name>_slave); empty when the mesh has neither.
+  static std::vector<int> patchIndices(const HexMesh& mesh, const std::string& name);
+
   lid_t nNodes() const { return static_cast<lid_t>(nodes_.extent(0)); }
   /// Node indices (host copy, sorted).
   const std::vector<lid_t>& hostNodes() const { return hostNodes_; }

@@ -107,6 +107,12 @@ Schema couplingSchema() {
                            "patches it carries (movingWall patches; their nodes follow the body rigidly, the fluid's "
                            "force and moment on them load the body)",
                            Schema::list("fluid patches of the body", Schema::string("patch name"))),
+           Presence::Optional)
+      .key("parentBodyPatches",
+           Schema::freeMap("membranes mounted on coupled bodies: membrane name -> patches of bodyPatches; each "
+                           "membrane node follows the body of the nearest listed patch, its FEM displacement (and "
+                           "clamp) relative to that body's frame; the membrane's fluid load is passed on to the body",
+                           Schema::list("parent patches", Schema::string("patch or baffle name"))),
            Presence::Optional);
 }
 
@@ -153,6 +159,8 @@ CouplingOptions readCouplingOptions(const SceneConfig& c) {
   o.motion.slidingPatches = c.get<std::vector<std::string>>("meshMotion.slidingPatches");
   for (const auto& name : c.keys("bodyPatches"))
     o.bodyPatches.push_back({name, c.get<std::vector<std::string>>("bodyPatches." + name)});
+  for (const auto& name : c.keys("parentBodyPatches"))
+    o.parentBodyPatches.push_back({name, c.get<std::vector<std::string>>("parentBodyPatches." + name)});
   return o;
 }
 

@@ -21,6 +21,7 @@
 ///   outsidePressure: 0      # pressure behind a membrane that replaces a wall patch
 ///   meshMotion: {sweeps: 50, minScaledJacobian: 0.05}
 ///   bodyPatches: {piston: [pistonFace]}   # rigid bodies (the `bodies` section) and the fluid patches they carry
+///   parentBodyPatches: {sail: [mast]}     # membranes mounted on those bodies (nearest listed patch)
 /// \endcode
 #include "core/SceneConfig.hpp"
 #include "coupling/acceleration/Acceleration.hpp"
@@ -62,6 +63,13 @@ struct CouplingOptions {
     std::vector<std::string> patches;
   };
   std::vector<BodyPatches> bodyPatches;  ///< empty: no body is coupled
+  /// \brief A membrane mounted on moving bodies: each of its nodes follows the body whose listed
+  /// patch (one of bodyPatches') is nearest, and its FEM displacement is relative to that body.
+  struct ParentPatches {
+    std::string membrane;
+    std::vector<std::string> patches;
+  };
+  std::vector<ParentPatches> parentBodyPatches;
 };
 
 /// Schema of the `coupling` section.

@@ -112,6 +112,7 @@ FsiCoupling::FsiCoupling(const CouplingOptions& options, const SceneConfig& sect
       throw InputError(section.where("meshMotion.slidingPatches." + std::to_string(i)), mesh_.noPatchMessage(s));
   }
   setUpBodies(section, layout);
+  setUpParents(section);
   smoother_ = std::make_unique<coupling::MeshSmoother>(mesh_, options_.motion);
   acceleration_ = coupling::makeAcceleration(options_.acceleration, layout);
 }
@@ -141,7 +142,8 @@ void FsiCoupling::setUpBodies(const SceneConfig& section, std::vector<coupling::
     for (std::size_t i = 0; i < bp.patches.size(); ++i) {
       const std::string& name = bp.patches[i];
       const std::string at = key + "." + std::to_string(i);
-      if (mesh_.findPatch(name) < 0) throw InputError(section.where(at), mesh_.noPatchMessage(name));
+      if (coupling::BodyPatchMotion::patchIndices(mesh_, name).empty())
+        throw InputError(section.where(at), mesh_.noPatchMessage(name) + " (or a baffle of that name)");
       for (int pi : bc.find(name)) {
         const fluid::ResolvedPatch& rp = bc.patches()[pi];
         if (rp.type != fluid::BoundaryType::Wall || rp.bc.wallMotion != fluid::WallMotion::MeshVelocity)
@@ -154,10 +156,56 @@ void FsiCoupling::setUpBodies(const SceneConfig& section, std::vector<coupling::
     b.rotation0 = kin.bodies[b.index].frame.rotation;
     bodies_.push_back(std::move(b));
   }
+  transforms_.resize(bodies_.size());
   // Bodies whose joints are all prescribed (or fixed) move the mesh without unknowns: one-way.
   bodyOffset_ = size_;
   if (sys.nDof() > 0) layout.push_back({"bodies", size_, sys.nDof()});
   size_ += sys.nDof();
+}
+
+void FsiCoupling::setUpParents(const SceneConfig& section) {
+  std::vector<std::string> membraneNames;
+  for (const Panel& p : panels_) {  // the scene's names: module "membrane.<name>" -> "<name>"
+    const std::string& n = p.module->panel().name;
+    membraneNames.push_back(n.rfind("membrane.", 0) == 0 ? n.substr(9) : n);
+  }
+  for (const auto& pp : options_.parentBodyPatches) {
+    const std::string key = "parentBodyPatches." + pp.membrane;
+    auto it = std::find(membraneNames.begin(), membraneNames.end(), pp.membrane);
+    if (it == membraneNames.end())
+      throw InputError(section.where(key), "no coupled membrane '" + pp.membrane + "'" +
+                                               didYouMean(pp.membrane, membraneNames) +
+                                               "; membranes: " + joinList(membraneNames));
+    Panel& p = panels_[static_cast<std::size_t>(it - membraneNames.begin())];
+    if (options_.viscousTraction)
+      throw InputError(section.where("viscousTraction"),
+                       "viscousTraction with membranes mounted on bodies (parentBodyPatches) is not supported yet");
+    if (p.wallVelocity)
+      throw InputError(section.where(key), "the fluid walls of " + pp.membrane +
+                                               " must take the mesh velocity on a moving frame: make them "
+                                               "'type: movingWall' instead of membraneWall");
+    std::vector<std::array<real, 3>> candidates;
+    std::vector<int> candidateBody;
+    auto pts = Kokkos::create_mirror_view_and_copy(HostSpace(), mesh_.points());
+    for (std::size_t i = 0; i < pp.patches.size(); ++i) {
+      const std::string& name = pp.patches[i];
+      int slot = -1;
+      for (std::size_t b = 0; b < bodies_.size() && slot < 0; ++b)
+        if (std::find(bodies_[b].patches.begin(), bodies_[b].patches.end(), name) != bodies_[b].patches.end())
+          slot = static_cast<int>(b);
+      if (slot < 0)
+        throw InputError(section.where(key + "." + std::to_string(i)),
+                         "'" + name + "' is not a patch of a coupled body (bodyPatches)");
+      const coupling::BodyPatchMotion patch(mesh_, {name});
+      for (lid_t v : patch.hostNodes()) {
+        candidates.push_back({pts(v, 0), pts(v, 1), pts(v, 2)});
+        candidateBody.push_back(slot);
+      }
+    }
+    p.parents = coupling::ParentFrames(p.module->solver().mesh().hostPoints(), candidates, candidateBody,
+                                       static_cast<int>(bodies_.size()));
+    p.mounted = true;
+  }
 }
 
 std::vector<Module*> FsiCoupling::parts() {
@@ -235,18 +283,30 @@ void FsiCoupling::updateBodyLoads(double scale) {
   if (bodies_.empty()) return;
   const fluid::FluidSolver& f = fluid_->solver();
   RigidBodySystem& sys = rigid_->system();
-  for (const CoupledBody& b : bodies_) {
+  for (std::size_t slot = 0; slot < bodies_.size(); ++slot) {
+    const CoupledBody& b = bodies_[slot];
     // Force and moment about the body's centre of mass in its latest state.
     const Eigen::Vector3d c = sys.bodyReport(b.index).position;
     Eigen::Vector3d force = Eigen::Vector3d::Zero(), moment = Eigen::Vector3d::Zero();
     for (const auto& patch : b.patches) {
       const fluid::PatchLoads L = fluid::patchLoads(f, patch, {c[0], c[1], c[2]});
       for (int k = 0; k < 3; ++k) {
-        force[k] += L.force[k];
-        moment[k] += L.moment[k];
+        force[k] += scale * L.force[k];
+        moment[k] += scale * L.moment[k];
       }
     }
-    sys.setExternalLoad(b.index, scale * force, scale * moment);
+    // Mounted membranes pass their load (already scaled and relaxed) on to their bodies.
+    for (const Panel& p : panels_) {
+      if (!p.mounted) continue;
+      const std::array<double, 6> L = p.parents.bodyLoad(
+          exec_, static_cast<int>(slot), {c[0], c[1], c[2]}, p.module->solver().mesh().elementNodes(), p.load,
+          p.iface.front, mesh_.nInternalFaces(), f.geometry().faceArea, f.geometry().faceCentroid);
+      for (int k = 0; k < 3; ++k) {
+        force[k] += L[k];
+        moment[k] += L[3 + k];
+      }
+    }
+    sys.setExternalLoad(b.index, force, moment);
   }
 }
 
@@ -309,8 +369,9 @@ void FsiCoupling::placeBodies(const InterfaceVector& x) {
   const Eigen::VectorXd q = x.segment(bodyOffset_, n), zero = Eigen::VectorXd::Zero(n);
   RigidTreeKinematics kin;
   sys.model().kinematics(stepEnd_, q, zero, zero, kin);
-  for (const CoupledBody& b : bodies_) {
-    coupling::RigidTransform T;
+  for (std::size_t slot = 0; slot < bodies_.size(); ++slot) {
+    const CoupledBody& b = bodies_[slot];
+    coupling::RigidTransform& T = transforms_[slot];
     const Eigen::Vector3d c = kin.bodies[b.index].com;
     const Eigen::Matrix3d Q = kin.bodies[b.index].frame.rotation * b.rotation0.transpose();
     for (int k = 0; k < 3; ++k) {
@@ -320,6 +381,8 @@ void FsiCoupling::placeBodies(const InterfaceVector& x) {
     }
     b.motion.apply(exec_, T, smoother_->displacement());
   }
+  for (Panel& p : panels_)
+    if (p.mounted) p.parents.setTransforms(transforms_);
 }
 
 void FsiCoupling::moveMesh(const InterfaceVector& x) {
@@ -328,7 +391,11 @@ void FsiCoupling::moveMesh(const InterfaceVector& x) {
     placeBodies(x);
     for (Panel& p : panels_) {
       toDevice(x, p.offset, p.iterate);
-      coupling::interfaceDisplacement(exec_, p.iface, p.iterate, smoother_->displacement());
+      if (p.mounted)
+        p.parents.displacement(exec_, p.module->solver().mesh().referencePoints(), p.iterate, p.iface.fluidNode,
+                               smoother_->displacement());
+      else
+        coupling::interfaceDisplacement(exec_, p.iface, p.iterate, smoother_->displacement());
     }
   }
   {

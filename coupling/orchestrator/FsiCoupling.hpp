@@ -31,6 +31,7 @@
 #include "coupling/MembraneModule.hpp"
 #include "coupling/RigidModule.hpp"
 #include "coupling/motion/BodyPatchMotion.hpp"
+#include "coupling/motion/ParentFrames.hpp"
 #include "coupling/interface/MembraneInterface.hpp"
 #include "coupling/motion/MeshSmoother.hpp"
 #include "coupling/orchestrator/CouplingConfig.hpp"
@@ -96,6 +97,8 @@ class FsiCoupling final : public Module {
     RealView smoothWork;
     RealView filtered;             ///< pNetFilterTau: the filtered load of the last step
     bool haveFiltered = false;
+    bool mounted = false;            ///< on moving bodies (parentBodyPatches): FEM relative to them
+    coupling::ParentFrames parents;  ///< mounted: each node's body and the bodies' motions
   };
   /// A rigid body of the coupling and the fluid patches it carries.
   struct CoupledBody {
@@ -129,6 +132,7 @@ class FsiCoupling final : public Module {
 
  private:
   void setUpBodies(const SceneConfig& section, std::vector<coupling::InterfaceBlock>& layout);
+  void setUpParents(const SceneConfig& section);
 
   CouplingOptions options_;
   HexMesh& mesh_;
@@ -141,6 +145,7 @@ class FsiCoupling final : public Module {
   std::unique_ptr<RigidModule> rigid_;
   std::vector<CoupledBody> bodies_;
   Eigen::Index bodyOffset_ = 0;  ///< the free coordinates of the rigid system in the interface vector
+  std::vector<coupling::RigidTransform> transforms_;  ///< per coupled body: its motion at the iterate being placed
   std::unique_ptr<coupling::MeshSmoother> smoother_;
   std::unique_ptr<coupling::Acceleration> acceleration_;
   Eigen::Index size_ = 0;

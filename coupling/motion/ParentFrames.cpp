@@ -1,0 +1,116 @@
+#include "coupling/motion/ParentFrames.hpp"
+
+#include "core/Error.hpp"
+#include "kernels/Blas.hpp"
+
+#include <algorithm>
+#include <limits>
+
+namespace mfsi::coupling {
+
+ParentFrames::ParentFrames(const std::vector<std::array<real, 3>>& nodes,
+                           const std::vector<std::array<real, 3>>& candidates, const std::vector<int>& candidateBody,
+                           int nBodies)
+    : nBodies_(nBodies) {
+  MFSI_CHECK(!candidates.empty() && candidates.size() == candidateBody.size(),
+             "parent frames: no parent patch nodes to follow");
+  // Nearest candidate of each body by brute force, once at set-up (membrane nodes x patch nodes).
+  const std::size_t nb = static_cast<std::size_t>(nBodies);
+  hostWeights_.assign(nodes.size() * nb, 0.0);
+  for (std::size_t i = 0; i < nodes.size(); ++i) {
+    std::vector<double> d2(nb, std::numeric_limits<double>::max());
+    for (std::size_t j = 0; j < candidates.size(); ++j) {
+      double s = 0;
+      for (int k = 0; k < 3; ++k) s += (nodes[i][k] - candidates[j][k]) * (nodes[i][k] - candidates[j][k]);
+      d2[candidateBody[j]] = std::min(d2[candidateBody[j]], s);
+    }
+    double* w = &hostWeights_[i * nb];
+    const auto on = std::min_element(d2.begin(), d2.end());
+    if (*on == 0.0) {  // on a parent's patch: that body alone
+      w[on - d2.begin()] = 1;
+      continue;
+    }
+    double sum = 0;
+    for (std::size_t b = 0; b < nb; ++b) {
+      w[b] = d2[b] < std::numeric_limits<double>::max() ? 1.0 / d2[b] : 0.0;
+      sum += w[b];
+    }
+    for (std::size_t b = 0; b < nb; ++b) w[b] /= sum;
+  }
+  weights_ = Kokkos::View<double**, MemSpace>("mfsi::coupling::parentFrames::weights", nodes.size(), nb);
+  auto h = Kokkos::create_mirror_view(weights_);
+  for (std::size_t i = 0; i < nodes.size(); ++i)
+    for (std::size_t b = 0; b < nb; ++b) h(i, b) = hostWeights_[i * nb + b];
+  Kokkos::deep_copy(weights_, h);
+  frames_ = Kokkos::View<double* [15], MemSpace>("mfsi::coupling::parentFrames::frames", nBodies);
+  std::vector<RigidTransform> identity(static_cast<std::size_t>(nBodies));
+  setTransforms(identity);
+}
+
+void ParentFrames::setTransforms(const std::vector<RigidTransform>& transforms) {
+  MFSI_CHECK(static_cast<int>(transforms.size()) == nBodies_, "parent frames: one transform per body expected");
+  auto h = Kokkos::create_mirror_view(frames_);
+  for (int b = 0; b < nBodies_; ++b) {
+    for (int k = 0; k < 3; ++k) {
+      h(b, k) = transforms[b].c0[k];
+      h(b, 3 + k) = transforms[b].c[k];
+    }
+    for (int k = 0; k < 9; ++k) h(b, 6 + k) = transforms[b].Q[k];
+  }
+  Kokkos::deep_copy(frames_, h);
+}
+
+void ParentFrames::displacement(const ExecSpace& exec, const ConstReal3View& reference, const ConstRealView& relative,
+                                const ConstIndexView& fluidNode, const Real3View& meshDisplacement) const {
+  const auto W = weights_;
+  const auto F = frames_;
+  const int nb = nBodies_;
+  Kokkos::parallel_for(
+      "mfsi::coupling::parentFrames::displacement", RangePolicy(exec, 0, static_cast<lid_t>(weights_.extent(0))),
+      KOKKOS_LAMBDA(lid_t i) {
+        real x[3] = {0, 0, 0};
+        for (int b = 0; b < nb; ++b) {
+          const real w = W(i, b);
+          if (w == 0) continue;
+          real r[3];
+          for (int k = 0; k < 3; ++k) r[k] = reference(i, k) + relative(3 * i + k) - F(b, k);
+          for (int k = 0; k < 3; ++k)
+            x[k] += w * (F(b, 3 + k) + F(b, 6 + 3 * k) * r[0] + F(b, 7 + 3 * k) * r[1] + F(b, 8 + 3 * k) * r[2]);
+        }
+        for (int k = 0; k < 3; ++k) meshDisplacement(fluidNode(i), k) = x[k] - reference(i, k);
+      });
+}
+
+std::array<double, 6> ParentFrames::bodyLoad(const ExecSpace& exec, int slot, const std::array<double, 3>& centre,
+                                             const ConstQuad4View& elementNodes, const ConstRealView& elementPressure,
+                                             const ConstIndexView& front, lid_t nInternalFaces,
+                                             const ConstReal3View& faceArea, const ConstReal3View& faceCentroid) const {
+  const auto W = weights_;
+  const int s = slot;
+  const real cx = centre[0], cy = centre[1], cz = centre[2];
+  return blas::reduce<6>(
+      exec, SolverComm{}, "mfsi::coupling::parentFrames::bodyLoad", static_cast<lid_t>(elementNodes.extent(0)),
+      KOKKOS_LAMBDA(lid_t e, blas::Sums<6> & acc) {
+        real share = 0;
+        int nn = 0;
+        for (int a = 0; a < 4; ++a) {
+          const lid_t v = elementNodes(e, a);
+          if (v < 0) continue;
+          ++nn;
+          share += W(v, s);
+        }
+        if (share == 0) return;
+        const lid_t f = front(e) + nInternalFaces;
+        const real w = elementPressure(e) * share / real(nn);
+        const real F[3] = {w * faceArea(f, 0), w * faceArea(f, 1), w * faceArea(f, 2)};
+        const real r[3] = {faceCentroid(f, 0) - cx, faceCentroid(f, 1) - cy, faceCentroid(f, 2) - cz};
+        acc[0] += F[0];
+        acc[1] += F[1];
+        acc[2] += F[2];
+        acc[3] += r[1] * F[2] - r[2] * F[1];
+        acc[4] += r[2] * F[0] - r[0] * F[2];
+        acc[5] += r[0] * F[1] - r[1] * F[0];
+      });
+}
+
+}  // namespace mfsi::coupling

@@ -1,0 +1,63 @@
+#pragma once
+/// \file
+/// \brief Membranes mounted on moving rigid bodies (`coupling.parentBodyPatches`, the seed's
+/// hierarchical motion): each membrane node follows its parent bodies' frames, and its FEM
+/// displacement is relative to them.
+///
+/// The FEM solves the membrane clamped at zero displacement relative to its frame; a node at
+/// reference position X with relative displacement u sits at
+///   x = sum_b w_b (c_b + Q_b (X + u - c0_b))
+/// (each body's rigid motion from the start, see RigidTransform), with weights w_b proportional to
+/// 1 / d_b^2, d_b the distance from X to the nearest node of body b's listed patches (w = 1 for
+/// the body a node lies on; one parent: w = 1 everywhere). A clamped node (u = 0) on a frame is
+/// where that body puts the frame's own nodes, so frame and membrane never gap or overlap, and the
+/// blend keeps a membrane spanning two independently moving bodies continuous (nearest-body
+/// frames would tear it where the nearest body changes). The fluid's load on a mounted membrane is
+/// passed on to its parents, each element's share by its nodes' weights (the membrane's own
+/// inertia is not).
+#include "core/Types.hpp"
+#include "coupling/motion/BodyPatchMotion.hpp"
+
+#include <array>
+#include <vector>
+
+namespace mfsi::coupling {
+
+class ParentFrames {
+ public:
+  ParentFrames() = default;
+  /// `nodes`: the membrane's reference node positions; `candidates` and `candidateBody`: the
+  /// reference positions of the listed parent patches' nodes and the body slot (0 .. nBodies - 1)
+  /// each belongs to. Bodies with no candidate get weight 0.
+  ParentFrames(const std::vector<std::array<real, 3>>& nodes, const std::vector<std::array<real, 3>>& candidates,
+               const std::vector<int>& candidateBody, int nBodies);
+
+  int nBodies() const { return nBodies_; }
+  /// Weight of body `slot` at membrane node i (host).
+  double weight(std::size_t i, int slot) const { return hostWeights_[i * static_cast<std::size_t>(nBodies_) + slot]; }
+
+  /// The bodies' current rigid motions (one per slot).
+  void setTransforms(const std::vector<RigidTransform>& transforms);
+
+  /// displacement(fluidNode(i)) = sum_b w_ib (c_b + Q_b (X_i + u_i - c0_b)) - X_i for the
+  /// membrane's nodes, with u the relative displacement (3 per node) and X the reference positions.
+  void displacement(const ExecSpace& exec, const ConstReal3View& reference, const ConstRealView& relative,
+                    const ConstIndexView& fluidNode, const Real3View& meshDisplacement) const;
+
+  /// Force and moment (about `centre`) on body `slot` of the element loads F_e = p_e S_f (S_f the
+  /// area vector of the element's fluid face f = front(e) + nInternalFaces, what the membrane
+  /// receives), each element's share being the mean of its nodes' weights for the body.
+  /// Returns {Fx, Fy, Fz, Mx, My, Mz}.
+  std::array<double, 6> bodyLoad(const ExecSpace& exec, int slot, const std::array<double, 3>& centre,
+                                 const ConstQuad4View& elementNodes, const ConstRealView& elementPressure,
+                                 const ConstIndexView& front, lid_t nInternalFaces, const ConstReal3View& faceArea,
+                                 const ConstReal3View& faceCentroid) const;
+
+ private:
+  Kokkos::View<double**, MemSpace> weights_;  ///< node x body slot
+  std::vector<double> hostWeights_;
+  Kokkos::View<double* [15], MemSpace> frames_;  ///< per slot: c0 (3), c (3), Q row-major (9)
+  int nBodies_ = 0;
+};
+
+}  // namespace mfsi::coupling
