@@ -7,6 +7,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <sstream>
 
 namespace mfsi {
@@ -14,6 +15,9 @@ namespace mfsi {
 using coupling::InterfaceVector;
 
 namespace {
+
+/// An interface residual this many times the step's smallest one means the iteration diverges.
+constexpr double kResidualGrowthLimit = 1e3;
 
 /// The fluid-mesh surface a membrane was cut from (the same call that built its mesh).
 FluidSurfaceMembraneInput fluidSurfaceOf(const MembranePanelOptions& panel, const HexMesh& mesh) {
@@ -474,6 +478,7 @@ void FsiCoupling::advance(const TimeState& t) {
   // (the fluid has not seen t_n+1 yet), so it never enters the acceleration's history.
   solveStructure(t1, t.dt);
   gatherTrial(x);
+  double smallestResidual = std::numeric_limits<double>::infinity();
   for (;;) {
     // An iterate the mesh cannot follow (a quasi-Newton step too far) is cut back towards the last
     // one it could, and the acceleration starts afresh from there.
@@ -486,6 +491,17 @@ void FsiCoupling::advance(const TimeState& t) {
     const double nx = acceleration_->norm(xt), nr = acceleration_->norm(xt - x);
     last_.displacementResidual = nx > 0 ? nr / nx : nr;
     last_.forceResidual = forceResidual_;
+    // An iteration that diverges (an Aitken omega that cannot reach the secant of a strong
+    // added-mass map, a poor quasi-Newton model) is stopped here with its cause, before its
+    // growing iterates break the fluid or the mesh.
+    smallestResidual = std::min(smallestResidual, nr);
+    if (!std::isfinite(nr) || (smallestResidual > 0 && nr > kResidualGrowthLimit * smallestResidual)) {
+      std::ostringstream os;
+      os << "coupling: the interface residual grew from " << smallestResidual << " to " << nr << " within the step to t = "
+         << t1 << " (" << last_.iterations << " iterations): the coupling iteration diverges; with Aitken, a strong "
+         << "added mass may need omegaMin below 1 / (1 + m_added / m), or IQN-ILS (iqnMaxCols > 0)";
+      throw DivergenceError(os.str());
+    }
     const bool small = last_.displacementResidual < options_.fsiTol &&
                        (options_.convergence == CouplingConvergence::Displacement || forceResidual_ < options_.fsiTol);
     if (last_.iterations >= options_.minFsiIter && small) {

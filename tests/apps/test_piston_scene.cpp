@@ -133,6 +133,16 @@ TEST(PistonScene, AitkenMeetsTheSameAnswerWhenOmegaMayReachTheSecant) {
   EXPECT_EQ(a.result.metrics.at("coupling.unconverged_steps"), 0.0);
 }
 
+TEST(PistonScene, AitkenBoundedAboveTheSecantIsStoppedAsDivergedByTheCoupling) {
+  // Default omegaMin = 0.05 > 1/101: each iteration multiplies the error by 1 - 0.05 * 101 = -4;
+  // the coupling stops the step itself, naming the cause, before the fluid breaks.
+  const PistonRun a = run(sized(0.01 * kAddedMass, {"coupling.iqnMaxCols=0"}), "aitken_bounded");
+  EXPECT_EQ(a.status, "diverged");
+  EXPECT_NE(a.error.find("coupling: the interface residual grew"), std::string::npos) << a.error;
+  EXPECT_NE(a.error.find("omegaMin"), std::string::npos) << a.error;
+  EXPECT_LT(a.steps(), 2);
+}
+
 TEST(PistonScene, BodyCouplingInputErrorsNameTheKey) {
   std::string e = inputError({"coupling.bodyPatches={pistn: [piston]}"});
   EXPECT_NE(e.find("bodyPatches.pistn"), std::string::npos) << e;
