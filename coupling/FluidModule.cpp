@@ -4,6 +4,7 @@
 #include "fluid/Loads.hpp"
 
 #include <cmath>
+#include <limits>
 
 namespace mfsi {
 
@@ -32,7 +33,39 @@ double dot(const Vec3& a, const Vec3& b) { return a[0] * b[0] + a[1] * b[1] + a[
 }  // namespace
 
 FluidModule::FluidModule(const HexMesh& mesh, const FluidOptions& options, FluidReports reports)
-    : Module("fluid"), solver_(mesh, options), reports_(std::move(reports)) {}
+    : Module("fluid"), solver_(mesh, options), reports_(std::move(reports)) {
+  if (reports_.probes.empty()) return;
+  // Nearest cell centroids, found once on the mesh as built.
+  const std::size_t n = reports_.probes.size();
+  probeCells_ = IndexView("mfsi::fluid::probes::cells", n);
+  probeValues_ = RealView("mfsi::fluid::probes::values", n);
+  auto C = Kokkos::create_mirror_view_and_copy(HostSpace(), solver_.geometry().cellCentroid);
+  auto h = Kokkos::create_mirror_view(probeCells_);
+  for (std::size_t i = 0; i < n; ++i) {
+    const Vec3& x = reports_.probes[i].point;
+    double best = std::numeric_limits<double>::max();
+    for (int c = 0; c < mesh.nCells(); ++c) {
+      const double d = (C(c, 0) - x[0]) * (C(c, 0) - x[0]) + (C(c, 1) - x[1]) * (C(c, 1) - x[1]) +
+                       (C(c, 2) - x[2]) * (C(c, 2) - x[2]);
+      if (d < best) {
+        best = d;
+        h(i) = c;
+      }
+    }
+  }
+  Kokkos::deep_copy(probeCells_, h);
+}
+
+std::vector<double> FluidModule::probePressures() const {
+  const IndexView cells = probeCells_;
+  const RealView values = probeValues_;
+  const ConstRealView p = solver_.pressure();
+  Kokkos::parallel_for(
+      "mfsi::fluid::probes::gather", RangePolicy(ExecSpace(), 0, static_cast<lid_t>(cells.extent(0))),
+      KOKKOS_LAMBDA(lid_t i) { values(i) = p(cells(i)); });
+  auto h = Kokkos::create_mirror_view_and_copy(HostSpace(), values);
+  return std::vector<double>(h.data(), h.data() + h.extent(0));
+}
 
 void FluidModule::advance(const TimeState& t) {
   last_ = solver_.solveStep(t.time, t.dt);
@@ -56,14 +89,20 @@ void FluidModule::account(const TimeState& t) {
 }
 
 std::vector<std::string> FluidModule::stepColumns() const {
-  return {"outerIterations",  "momentumIterations",   "pressureIterations",   "continuityMax",
-          "momentumResidual", "pressureResidual",     "finalMomentumResidual", "finalPressureResidual"};
+  std::vector<std::string> columns = {"outerIterations",  "momentumIterations",   "pressureIterations",
+                                      "continuityMax",    "momentumResidual",     "pressureResidual",
+                                      "finalMomentumResidual", "finalPressureResidual"};
+  for (const auto& p : reports_.probes) columns.push_back("probe." + p.name);
+  return columns;
 }
 
 void FluidModule::appendStepValues(std::vector<double>& v) const {
   v.insert(v.end(), {double(last_.outerIterations), double(last_.momentumIterations), double(last_.pressureIterations),
                      last_.continuityMax, last_.momentumResidual, last_.pressureResidual, last_.finalMomentumResidual,
                      last_.finalPressureResidual});
+  if (reports_.probes.empty()) return;
+  const std::vector<double> p = probePressures();
+  v.insert(v.end(), p.begin(), p.end());
 }
 
 void FluidModule::addMetrics(std::map<std::string, double>& m) const {

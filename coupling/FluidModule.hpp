@@ -31,11 +31,16 @@ class FluidModule final : public Module {
   fluid::FluidSolver& solver() { return solver_; }
   const fluid::StepResult& lastStep() const { return last_; }
 
+  /// The probes' cell pressures now (public for nvcc: it launches a kernel).
+  std::vector<double> probePressures() const;
+
  private:
   void account(const TimeState& t);  ///< totals and the divergence check of a solve
 
   fluid::FluidSolver solver_;
   FluidReports reports_;
+  IndexView probeCells_;  ///< the cells of reports_.probes
+  RealView probeValues_;
   fluid::StepResult last_;
   long long outerTotal_ = 0, pressureTotal_ = 0, momentumTotal_ = 0;
 };

@@ -244,6 +244,14 @@ Schema fluidSchema() {
       .key("forces", Schema::list("patches whose force and moment are reported", forceSchema()), Presence::Optional)
       .key("pressureDifferences", Schema::list("pressure differences reported as metrics", pressureDifferenceSchema()),
            Presence::Optional)
+      .key("probes",
+           Schema::list("pressure probes written every step (steps.csv column fluid.probe.<name>): the cell "
+                        "whose centroid is nearest to the point in the mesh as built (the cell moves with a moving "
+                        "mesh)",
+                        Schema::map("a pressure probe")
+                            .key("name", Schema::string("column name"))
+                            .key("point", Schema::realVector(3, "point", "m"))),
+           Presence::Optional)
       .key("ghia",
            Schema::map("compare a lid-driven cavity (mesh bounding box in x, y; lid at y max moving in +x) with "
                        "Ghia, Ghia & Shin (1982): metrics fluid.ghia_u_max_err, fluid.ghia_v_max_err")
@@ -344,6 +352,10 @@ FluidReports readFluidReports(const SceneConfig& c, const HexMesh& mesh, const F
     if (!pr.patch.empty() && mesh.findPatch(pr.patch) < 0)
       throw InputError(p.where("patch"), mesh.noPatchMessage(pr.patch));
     r.pressureDifferences.push_back(pr);
+  }
+  for (std::size_t i = 0; i < c.size("probes"); ++i) {
+    const SceneConfig p = c.child("probes." + std::to_string(i));
+    r.probes.push_back({p.get<std::string>("name"), vec3(p, "point")});
   }
   if (c.has("ghia") && c.get<bool>("ghia.enabled")) {
     r.ghia.enabled = true;

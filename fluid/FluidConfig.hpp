@@ -60,6 +60,12 @@ struct PressureDifferenceReport {
   std::string patch;  ///< "" for cell values
 };
 
+/// \brief Pressure of the cell nearest to a point (of the reference mesh), written every step.
+struct ProbeReport {
+  std::string name;
+  fluid::Vec3 point{0, 0, 0};
+};
+
 /// \brief Lid-driven cavity comparison with Ghia et al. (1982).
 struct GhiaReport {
   bool enabled = false;
@@ -71,6 +77,7 @@ struct GhiaReport {
 struct FluidReports {
   std::vector<ForceReport> forces;
   std::vector<PressureDifferenceReport> pressureDifferences;
+  std::vector<ProbeReport> probes;
   GhiaReport ghia;
 };
 

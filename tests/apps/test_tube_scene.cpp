@@ -1,0 +1,68 @@
+// The elastic-tube pressure-wave benchmark with a membrane wall (cases/membrane-tube.yaml): the
+// pressure pulse travels at the Moens-Korteweg speed sqrt(E h / (2 rho R)) = 5.48 m/s, measured
+// from the times the axis pressure (probes every step) reaches half the inlet pressure at z = 10
+// and 30 mm; strong added mass (rho R / (rho_s h) = 4.2) converged by IQN-ILS every step.
+#include "core/Error.hpp"
+#include "coupling/Module.hpp"
+#include "coupling/Simulation.hpp"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <map>
+#include <sstream>
+#include <string>
+#include <vector>
+
+namespace {
+
+/// steps.csv as columns.
+std::map<std::string, std::vector<double>> readSteps(const std::string& file) {
+  std::ifstream in(file);
+  std::string line, cell;
+  std::getline(in, line);
+  std::vector<std::string> names;
+  for (std::istringstream h(line); std::getline(h, cell, ',');) names.push_back(cell);
+  std::map<std::string, std::vector<double>> cols;
+  while (std::getline(in, line)) {
+    std::istringstream s(line);
+    for (std::size_t k = 0; k < names.size() && std::getline(s, cell, ','); ++k) cols[names[k]].push_back(std::stod(cell));
+  }
+  return cols;
+}
+
+/// First time the series rises through `level` (linear between steps), NAN if it never does.
+double crossing(const std::vector<double>& t, const std::vector<double>& v, double level) {
+  for (std::size_t i = 1; i < v.size(); ++i)
+    if (v[i - 1] < level && v[i] >= level) return t[i - 1] + (t[i] - t[i - 1]) * (level - v[i - 1]) / (v[i] - v[i - 1]);
+  return NAN;
+}
+
+}  // namespace
+
+TEST(TubeScene, PulseTravelsAtTheMoensKortewegSpeed) {
+  auto cfg = mfsi::SceneConfig::load(std::string(MFSI_CASES_DIR) + "/membrane-tube.yaml", mfsi::sceneSchema(),
+                                     {"time.endTime=0.006"});
+  const std::string dir = ::testing::TempDir() + "/membrane_tube";
+  std::filesystem::create_directories(dir);
+  mfsi::RunResult r;
+  {
+    mfsi::Simulation sim(cfg);
+    r = sim.run(dir, false);
+  }
+  const auto steps = readSteps(dir + "/steps.csv");
+  const double half = 0.5 * 1333.2;
+  const double t10 = crossing(steps.at("time"), steps.at("fluid.probe.p_z10"), half);
+  const double t30 = crossing(steps.at("time"), steps.at("fluid.probe.p_z30"), half);
+  const double speed = 0.02 / (t30 - t10), mk = std::sqrt(3.0e5 * 0.001 / (2 * 1000 * 0.005));
+  std::printf("pulse at z = 10 mm: %.4f ms, 30 mm: %.4f ms: %.3f m/s (Moens-Korteweg %.3f m/s); %.2f coupling "
+              "iterations per step\n",
+              1e3 * t10, 1e3 * t30, speed, mk, r.metrics.at("coupling.mean_iterations"));
+  EXPECT_NEAR(speed / mk, 1.0, 0.05);
+  EXPECT_EQ(r.metrics.at("coupling.unconverged_steps"), 0.0);
+  // 9.7 today (peers with a solid wall: 9.1-9.4; the target of 6 is not met): a guard
+  // against losing the quasi-Newton's efficiency, not the target.
+  EXPECT_LE(r.metrics.at("coupling.mean_iterations"), 11.0);
+}
