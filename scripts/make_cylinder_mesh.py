@@ -46,6 +46,9 @@ import math
 import os
 import sys
 
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from gmsh_hex import write_hex_msh  # noqa: E402
+
 L_CHANNEL, H_CHANNEL = 2.2, 0.41
 CX, CY, RADIUS = 0.2, 0.2, 0.05
 SQ_LO, SQ_HI = 0.1, 0.3  # the square around the cylinder that holds the O-grid
@@ -203,45 +206,13 @@ def min_scaled_jacobian(coords, cells):
     return worst
 
 
-def fmt(v):
-    s = "%.9g" % v
-    return "0" if s == "-0" else s
-
-
 def write_msh(path, mesh):
     coords = node_coords(mesh)
     cells = hexes(mesh)
     faces = {p: [tuple(cells[q][k] for k in f) for q, f in mesh.edges[p]] for p in mesh.edges}
     faces["frontAndBack"] = [tuple(c[k] for k in FACE_ZM) for c in cells] + \
         [tuple(c[k] for k in FACE_ZP) for c in cells]
-    out = ["$MeshFormat", "4.1 0 8", "$EndMeshFormat", "$PhysicalNames", str(len(PATCHES) + 1)]
-    out += ['2 %d "%s"' % (t + 1, p) for t, p in enumerate(PATCHES)]
-    out += ['3 %d "fluid"' % VOLUME_TAG, "$EndPhysicalNames", "$Entities", "0 0 %d 1" % len(PATCHES)]
-    for t, p in enumerate(PATCHES):
-        pts = [coords[v] for f in faces[p] for v in f]
-        box = [min(c[d] for c in pts) for d in range(3)] + [max(c[d] for c in pts) for d in range(3)]
-        out.append("%d %s 1 %d 0" % (t + 1, " ".join(fmt(b) for b in box), t + 1))
-    out.append("1 0 0 0 %s %s %s 1 %d %d %s" % (fmt(L_CHANNEL), fmt(H_CHANNEL), fmt(DZ), VOLUME_TAG, len(PATCHES),
-                                                " ".join(str(t + 1) for t in range(len(PATCHES)))))
-    out += ["$EndEntities", "$Nodes", "1 %d 1 %d" % (len(coords), len(coords)), "3 1 0 %d" % len(coords)]
-    out += [str(i + 1) for i in range(len(coords))]
-    out += ["%s %s %s" % (fmt(x), fmt(y), fmt(z)) for x, y, z in coords]
-    n_elem = len(cells) + sum(len(f) for f in faces.values())
-    out += ["$EndNodes", "$Elements", "%d %d 1 %d" % (len(PATCHES) + 1, n_elem, n_elem)]
-    tag = 0
-    out.append("3 1 5 %d" % len(cells))
-    for c in cells:
-        tag += 1
-        out.append("%d %s" % (tag, " ".join(str(v + 1) for v in c)))
-    for t, p in enumerate(PATCHES):
-        out.append("2 %d 3 %d" % (t + 1, len(faces[p])))
-        for f in faces[p]:
-            tag += 1
-            out.append("%d %s" % (tag, " ".join(str(v + 1) for v in f)))
-    out.append("$EndElements")
-    os.makedirs(os.path.dirname(os.path.abspath(path)), exist_ok=True)
-    with open(path, "w") as fh:
-        fh.write("\n".join(out) + "\n")
+    write_hex_msh(path, PATCHES, coords, cells, faces, (0, 0, 0, L_CHANNEL, H_CHANNEL, DZ), VOLUME_TAG)
     return faces
 
 

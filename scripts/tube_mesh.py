@@ -36,6 +36,9 @@ import sys
 
 import numpy as np
 
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from gmsh_hex import write_hex_msh  # noqa: E402
+
 PATCHES = ["inlet", "outlet", "wall"]  # physical surface tags 1..3
 VOLUME_TAG = 4
 # Hex faces (core/HexMesh.hpp kHexFaces), outward normals.
@@ -123,44 +126,8 @@ def min_scaled_jacobian(coords, cells):
     return float((det / lens).min())
 
 
-def fmt(v):
-    s = "%.9g" % v
-    return "0" if s == "-0" else s
-
-
 def write_msh(path, coords, cells, faces, length, radius):
-    out = ["$MeshFormat", "4.1 0 8", "$EndMeshFormat", "$PhysicalNames", str(len(PATCHES) + 1)]
-    out += ['2 %d "%s"' % (t + 1, p) for t, p in enumerate(PATCHES)]
-    out += ['3 %d "fluid"' % VOLUME_TAG, "$EndPhysicalNames", "$Entities", "0 0 %d 1" % len(PATCHES)]
-    for t, p in enumerate(PATCHES):
-        pts = coords[faces[p].ravel()]
-        box = list(pts.min(axis=0)) + list(pts.max(axis=0))
-        out.append("%d %s 1 %d 0" % (t + 1, " ".join(fmt(b) for b in box), t + 1))
-    out.append("1 %s %s %s %s %s %s 1 %d %d %s" % (
-        fmt(-radius), fmt(-radius), "0", fmt(radius), fmt(radius), fmt(length), VOLUME_TAG, len(PATCHES),
-        " ".join(str(t + 1) for t in range(len(PATCHES)))))
-    nn = len(coords)
-    out += ["$EndEntities", "$Nodes", "1 %d 1 %d" % (nn, nn), "3 1 0 %d" % nn]
-    out += [str(i + 1) for i in range(nn)]
-    out += ["%s %s %s" % (fmt(x), fmt(y), fmt(z)) for x, y, z in coords]
-    n_elem = len(cells) + sum(len(f) for f in faces.values())
-    out += ["$EndNodes", "$Elements", "%d %d 1 %d" % (len(PATCHES) + 1, n_elem, n_elem)]
-    tag = 0
-    out.append("3 1 5 %d" % len(cells))
-    for c in cells:
-        tag += 1
-        out.append("%d %s" % (tag, " ".join(str(v + 1) for v in c)))
-    for t, p in enumerate(PATCHES):
-        out.append("2 %d 3 %d" % (t + 1, len(faces[p])))
-        for f in faces[p]:
-            tag += 1
-            out.append("%d %s" % (tag, " ".join(str(v + 1) for v in f)))
-    out.append("$EndElements")
-    os.makedirs(os.path.dirname(os.path.abspath(path)), exist_ok=True)
-    tmp = path + ".tmp"
-    with open(tmp, "w") as fh:
-        fh.write("\n".join(out) + "\n")
-    os.replace(tmp, path)  # never leave a truncated mesh under the final name
+    write_hex_msh(path, PATCHES, coords, cells, faces, (-radius, -radius, 0, radius, radius, length), VOLUME_TAG)
 
 
 def main():
