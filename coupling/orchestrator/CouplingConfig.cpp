@@ -97,6 +97,18 @@ Schema couplingSchema() {
       .key("outsidePressure",
            Schema::real("pressure behind a membrane that replaces a boundary patch (its load is p - this)", "Pa"),
            Default(o.outsidePressure))
+      .key("maxMeshVelocity",
+           Schema::real("limit of a coupled body's centre-of-mass move per coupling iteration, divided by the time "
+                        "step (0: off)",
+                        "m/s")
+               .atLeast(0),
+           Default(o.maxMeshVelocity))
+      .key("maxDeltaDispFrac",
+           Schema::real("limit of a membrane node's move per coupling iteration, as a fraction of sqrt(membrane "
+                        "area) (0: off)",
+                        "-")
+               .atLeast(0),
+           Default(o.maxDeltaDispFrac))
       .key("viscousTraction",
            Schema::boolean("load the membranes with the fluid's viscous traction too (nodal forces), not the "
                            "pressure alone"),
@@ -149,6 +161,8 @@ CouplingOptions readCouplingOptions(const SceneConfig& c) {
   o.pClamp = c.get<double>("pClamp");
   o.outsidePressure = c.get<double>("outsidePressure");
   o.viscousTraction = c.get<bool>("viscousTraction");
+  o.maxMeshVelocity = c.get<double>("maxMeshVelocity");
+  o.maxDeltaDispFrac = c.get<double>("maxDeltaDispFrac");
   o.motion.method = c.get<std::string>("meshMotion.method") == "jacobi" ? coupling::MeshMotionMethod::Jacobi
                                                                         : coupling::MeshMotionMethod::ConjugateGradient;
   o.motion.sweeps = c.get<int>("meshMotion.sweeps");

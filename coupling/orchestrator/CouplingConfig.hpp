@@ -55,6 +55,11 @@ struct CouplingOptions {
   double fsiRampTime = 0;     ///< s
   double pClamp = 0;          ///< |pNet| limit [Pa] (0: none)
   double outsidePressure = 0; ///< Pa
+  /// Limit of a body's centre-of-mass move per coupling iteration, over the time step [m/s] (0: off).
+  double maxMeshVelocity = 0;
+  /// Limit of a membrane node's move per coupling iteration, as a fraction of the membrane's
+  /// characteristic length sqrt(reference area) (0: off): the seed's bow-limiter.
+  double maxDeltaDispFrac = 0;
   bool viscousTraction = false;  ///< add the fluid's viscous traction to the membrane loads
   coupling::MeshSmootherOptions motion;
   /// \brief A rigid body of the `bodies` section and the fluid patches that move with it.

@@ -366,6 +366,43 @@ void FsiCoupling::commitStructure() {
   }
 }
 
+bool FsiCoupling::limitUpdate(InterfaceVector& x, const InterfaceVector& previous, double dt) const {
+  bool limited = false;
+  if (options_.maxDeltaDispFrac > 0)
+    for (const Panel& p : panels_) {
+      const MembraneMesh& mm = p.module->solver().mesh();
+      const double cap = options_.maxDeltaDispFrac * std::sqrt(mm.referenceArea());
+      for (Eigen::Index i = 0; i < 3 * Eigen::Index(mm.nNodes()); i += 3) {
+        const Eigen::Index o = p.offset + i;
+        const double n = (x.segment<3>(o) - previous.segment<3>(o)).norm();
+        if (n <= cap) continue;
+        x.segment<3>(o) = previous.segment<3>(o) + (cap / n) * (x.segment<3>(o) - previous.segment<3>(o));
+        limited = true;
+      }
+    }
+  if (options_.maxMeshVelocity > 0 && !bodies_.empty() && rigid_->system().nDof() > 0) {
+    // The largest factor on the coordinate update that keeps every coupled body's centre within the limit.
+    const RigidBodySystem& sys = rigid_->system();
+    const Eigen::Index n = sys.nDof();
+    const Eigen::VectorXd q0 = previous.segment(bodyOffset_, n), q1 = x.segment(bodyOffset_, n),
+                          zero = Eigen::VectorXd::Zero(n);
+    RigidTreeKinematics k0, k1;
+    sys.model().kinematics(stepEnd_, q0, zero, zero, k0);
+    sys.model().kinematics(stepEnd_, q1, zero, zero, k1);
+    const double cap = options_.maxMeshVelocity * dt;
+    double factor = 1;
+    for (const CoupledBody& b : bodies_) {
+      const double move = (k1.bodies[b.index].com - k0.bodies[b.index].com).norm();
+      if (move > cap) factor = std::min(factor, cap / move);
+    }
+    if (factor < 1) {
+      x.segment(bodyOffset_, n) = q0 + factor * (q1 - q0);
+      limited = true;
+    }
+  }
+  return limited;
+}
+
 void FsiCoupling::placeBodies(const InterfaceVector& x) {
   if (bodies_.empty()) return;
   const RigidBodySystem& sys = rigid_->system();
@@ -510,9 +547,11 @@ void FsiCoupling::advance(const TimeState& t) {
     }
     if (last_.iterations >= options_.maxFsiIter) break;
     ScopedTimer timer(timers_, "coupling.acceleration");
+    const InterfaceVector previous = x;
     const coupling::AccelerationReport ar = acceleration_->update(xt, x);
     last_.omega = ar.omega;
     last_.columns = ar.columns;
+    if (limitUpdate(x, previous, t.dt)) ++last_.limited;
     setTrial(x);
   }
   acceleration_->endStep();
@@ -527,6 +566,7 @@ void FsiCoupling::advance(const TimeState& t) {
   iterationsTotal_ += last_.iterations;
   maxIterations_ = std::max(maxIterations_, last_.iterations);
   cutBacksTotal_ += last_.cutBacks;
+  limitedTotal_ += last_.limited;
   minJacobian_ = std::min(minJacobian_, last_.minScaledJacobian);
   if (implicit && !last_.converged) {
     ++unconvergedSteps_;
@@ -546,14 +586,14 @@ void FsiCoupling::advance(const TimeState& t) {
 }
 
 std::vector<std::string> FsiCoupling::stepColumns() const {
-  return {"iterations", "displacementResidual", "forceResidual", "omega",           "columns",
-          "minScaledJacobian", "cutBacks",        "motionIterations"};
+  return {"iterations",        "displacementResidual", "forceResidual",    "omega",  "columns",
+          "minScaledJacobian", "cutBacks",             "motionIterations", "limited"};
 }
 
 void FsiCoupling::appendStepValues(std::vector<double>& v) const {
   v.insert(v.end(), {double(last_.iterations), last_.displacementResidual, last_.forceResidual, last_.omega,
                      double(last_.columns), last_.minScaledJacobian, double(last_.cutBacks),
-                     double(last_.motionIterations)});
+                     double(last_.motionIterations), double(last_.limited)});
 }
 
 void FsiCoupling::addMetrics(std::map<std::string, double>& m) const {
@@ -563,6 +603,7 @@ void FsiCoupling::addMetrics(std::map<std::string, double>& m) const {
   m["coupling.unconverged_steps"] = double(unconvergedSteps_);
   m["coupling.min_scaled_jacobian"] = minJacobian_;
   m["coupling.cut_backs"] = double(cutBacksTotal_);
+  m["coupling.limited_updates"] = double(limitedTotal_);
   const auto& all = timers_.all();
   auto seconds = [&](const char* k) {
     auto it = all.find(k);

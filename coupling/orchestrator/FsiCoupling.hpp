@@ -74,6 +74,7 @@ class FsiCoupling final : public Module {
     double minScaledJacobian = 1;
     int cutBacks = 0;  ///< iterates the mesh could not follow, cut back towards the last good one
     int motionIterations = 0;  ///< CG iterations (or Jacobi sweeps) of the step's mesh motions
+    int limited = 0;           ///< updates shortened by maxDeltaDispFrac / maxMeshVelocity
   };
   const StepReport& lastStep() const { return last_; }
 
@@ -120,6 +121,9 @@ class FsiCoupling final : public Module {
   void gatherTrial(coupling::InterfaceVector& xt) const;
   void setTrial(const coupling::InterfaceVector& x);
   void commitStructure();
+  /// maxDeltaDispFrac and maxMeshVelocity: x's move from `previous` is shortened where it exceeds
+  /// them (per membrane node; per body, its whole coordinate update). Returns true when it was.
+  bool limitUpdate(coupling::InterfaceVector& x, const coupling::InterfaceVector& previous, double dt) const;
   /// Coupled bodies' patch nodes to the poses of the coordinates in x (the mesh motion's prescribed displacements).
   void placeBodies(const coupling::InterfaceVector& x);
   void moveMesh(const coupling::InterfaceVector& x);
@@ -152,7 +156,8 @@ class FsiCoupling final : public Module {
   double stepEnd_ = 0;  ///< t_n+1 of the step being solved
   double forceResidual_ = 0;
   StepReport last_;
-  long long steps_ = 0, iterationsTotal_ = 0, unconvergedSteps_ = 0, unconvergedInARow_ = 0, cutBacksTotal_ = 0;
+  long long steps_ = 0, iterationsTotal_ = 0, unconvergedSteps_ = 0, unconvergedInARow_ = 0, cutBacksTotal_ = 0,
+            limitedTotal_ = 0;
   int maxIterations_ = 0;
   double minJacobian_ = 1;
 };

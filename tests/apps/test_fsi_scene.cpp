@@ -153,6 +153,20 @@ TEST(FsiScene, TheLoadFilterTheRampAndTheStartTimeHoldTheResponseBack) {
   EXPECT_EQ(still.at("membrane.bottom.maxDisplacement"), 0.0) << "structure frozen until fsiStartTime";
 }
 
+TEST(FsiScene, TheBowLimiterSlowsTheIterationNotTheAnswer) {
+  // maxDeltaDispFrac = 2e-5: a membrane node moves at most 4.5e-6 m per coupling iteration
+  // (2e-5 sqrt(0.05 m^2)), far less than the predictor's correction: more iterations, same answer.
+  std::vector<std::string> limited = coarse(12, 3.0);
+  limited.push_back("coupling.maxDeltaDispFrac=2e-5");
+  const auto free = run(coarse(12, 3.0), "bow_free").metrics;
+  const auto slow = run(limited, "bow_limited").metrics;
+  EXPECT_EQ(free.at("coupling.limited_updates"), 0.0);
+  EXPECT_GT(slow.at("coupling.limited_updates"), 50.0);
+  EXPECT_GT(slow.at("coupling.mean_iterations"), free.at("coupling.mean_iterations") + 1);
+  EXPECT_EQ(slow.at("coupling.unconverged_steps"), 0.0);
+  EXPECT_TRUE(near(slow.at("membrane.bottom.centreUy"), free.at("membrane.bottom.centreUy"), Tol{0, 1e-4}));
+}
+
 TEST(FsiScene, CouplingInputErrorsNameTheKey) {
   // The membrane's wall must move with it.
   std::string e = inputError({"fluid.boundary.bottom.type=wall"});

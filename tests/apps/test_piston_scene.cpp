@@ -143,6 +143,21 @@ TEST(PistonScene, AitkenBoundedAboveTheSecantIsStoppedAsDivergedByTheCoupling) {
   EXPECT_LT(a.steps(), 2);
 }
 
+TEST(PistonScene, MaxMeshVelocityLimitsEachIterationNotTheAnswer) {
+  // The piston moves at up to 0.0106 m/s; a limit of 0.002 m/s per iteration shortens most
+  // updates, the step takes more iterations and lands on the same fixed point.
+  const PistonRun free = run({"time.endTime=0.3"}, "velocity_free");
+  const PistonRun slow = run({"time.endTime=0.3", "coupling.maxMeshVelocity=0.002"}, "velocity_limited");
+  ASSERT_EQ(free.status, "ok") << free.error;
+  ASSERT_EQ(slow.status, "ok") << slow.error;
+  EXPECT_EQ(free.result.metrics.at("coupling.limited_updates"), 0.0);
+  EXPECT_GT(slow.result.metrics.at("coupling.limited_updates"), 50.0);
+  EXPECT_GT(slow.result.metrics.at("coupling.mean_iterations"), free.result.metrics.at("coupling.mean_iterations") + 2);
+  EXPECT_EQ(slow.result.metrics.at("coupling.unconverged_steps"), 0.0);
+  ASSERT_EQ(free.x.size(), slow.x.size());
+  for (std::size_t i = 0; i < free.x.size(); ++i) EXPECT_NEAR(slow.x[i], free.x[i], 1e-11) << "step " << i;
+}
+
 TEST(PistonScene, BodyCouplingInputErrorsNameTheKey) {
   std::string e = inputError({"coupling.bodyPatches={pistn: [piston]}"});
   EXPECT_NE(e.find("bodyPatches.pistn"), std::string::npos) << e;
