@@ -19,7 +19,12 @@ double periodFromZeroCrossings(const std::vector<double>& w, double dt) {
 }  // namespace
 
 MembraneModule::MembraneModule(const MembranePanelOptions& options) : Module(options.name), panel_(options) {
-  const MembraneMesh mesh = buildMembraneMesh(generateMembraneMesh(panel_.mesh));
+  // A membrane cut from the fluid mesh keeps the maps of its surface for the coupling.
+  if (panel_.mesh.kind == MembraneMeshKind::Baffle)
+    surface_ = membraneMeshFromBaffle(*panel_.mesh.fluidMesh, panel_.mesh.baffle);
+  else if (panel_.mesh.kind == MembraneMeshKind::Patch)
+    surface_ = membraneMeshFromPatch(*panel_.mesh.fluidMesh, panel_.mesh.patch);
+  const MembraneMesh mesh = buildMembraneMesh(surface_ ? surface_->mesh : generateMembraneMesh(panel_.mesh));
   solver_ = std::make_unique<MembraneSolver>(mesh, panel_.options, resolveMembraneBoundary(panel_.boundary, mesh),
                                              panel_.loads);
   centre_ =

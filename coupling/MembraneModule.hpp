@@ -9,9 +9,11 @@
 /// solve does not converge or the state is not finite.
 #include "coupling/Module.hpp"
 #include "structure/membrane/MembraneConfig.hpp"
+#include "structure/membrane/MembraneMeshImport.hpp"
 #include "structure/membrane/MembraneSolver.hpp"
 
 #include <memory>
+#include <optional>
 
 namespace mfsi {
 
@@ -34,12 +36,16 @@ class MembraneModule final : public Module {
   /// it, e.g. the coupling's commit). Throws DivergenceError on a non-finite displacement.
   void sampleState() { sample(); }
   const MembranePanelOptions& panel() const { return panel_; }
+  /// The fluid-mesh surface the membrane was cut from (baffle or boundary patch: its node and face
+  /// maps); null for other meshes.
+  const FluidSurfaceMembraneInput* fluidSurface() const { return surface_ ? &*surface_ : nullptr; }
 
  private:
   void check(const MembraneSolveReport& report, const char* what, double time);
   void sample();  ///< max |u| and centre deflection of the current state
 
   MembranePanelOptions panel_;
+  std::optional<FluidSurfaceMembraneInput> surface_;
   std::unique_ptr<MembraneSolver> solver_;
   lid_t centre_ = 0;
   std::array<real, 3> centreNormal_{0, 0, 1};

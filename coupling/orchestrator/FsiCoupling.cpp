@@ -19,12 +19,6 @@ namespace {
 /// An interface residual this many times the step's smallest one means the iteration diverges.
 constexpr double kResidualGrowthLimit = 1e3;
 
-/// The fluid-mesh surface a membrane was cut from (the same call that built its mesh).
-FluidSurfaceMembraneInput fluidSurfaceOf(const MembranePanelOptions& panel, const HexMesh& mesh) {
-  return panel.mesh.kind == MembraneMeshKind::Baffle ? membraneMeshFromBaffle(mesh, panel.mesh.baffle)
-                                                     : membraneMeshFromPatch(mesh, panel.mesh.patch);
-}
-
 /// Device flat vector -> a slice of a host interface vector, and back.
 void toHost(const ConstRealView& d, InterfaceVector& x, Eigen::Index offset) {
   auto h = Kokkos::create_mirror_view_and_copy(HostSpace(), d);
@@ -62,7 +56,8 @@ FsiCoupling::FsiCoupling(const CouplingOptions& options, const SceneConfig& sect
                                                     "or 'mesh: {boundaryPatch: ...}' to couple it");
     Panel p;
     p.module = m.get();
-    const FluidSurfaceMembraneInput surf = fluidSurfaceOf(po, mesh_);
+    MFSI_CHECK(m->fluidSurface() != nullptr, "coupling: " << m->name() << " keeps no fluid surface");
+    const FluidSurfaceMembraneInput& surf = *m->fluidSurface();
     const MembraneMesh& mm = m->solver().mesh();
     MFSI_CHECK(static_cast<lid_t>(surf.fluidNode.size()) == mm.nNodes() &&
                    static_cast<lid_t>(surf.masterFace.size()) == mm.nElements(),
