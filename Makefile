@@ -4,8 +4,8 @@ MAKEFLAGS += --no-print-directory
 #   make test   set-up -> configure -> build -> ctest
 # Portability and correctness builds (scripts/build-variant.sh, each in its own build directory):
 #   make build-cuda    CUDA + OpenMP Kokkos, nvcc_wrapper: compiles and links every target (no GPU run)
-#   make test-asan     AddressSanitizer + UndefinedBehaviorSanitizer build, the suite but its longest accuracy runs
-#   make test-bounds   Kokkos bounds-checked (debug) build, the suite but its longest accuracy runs
+#   make test-asan     AddressSanitizer + UndefinedBehaviorSanitizer build, the suite but its longest accuracy runs (no benchmarks)
+#   make test-bounds   Kokkos bounds-checked (debug) build, the suite but its longest accuracy runs (no benchmarks)
 # Options: BUILD_DIR=build  JOBS=<n>  SCENE=<file or name>  KOKKOS_ROOT=<your Kokkos>
 BUILD_DIR ?= build
 JOBS ?= $(shell nproc)
