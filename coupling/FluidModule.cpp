@@ -4,7 +4,6 @@
 #include "fluid/Loads.hpp"
 
 #include <cmath>
-#include <limits>
 
 namespace mfsi {
 
@@ -12,20 +11,26 @@ using namespace fluid;
 
 namespace {
 
+// The cell whose centroid (host copy C) is nearest to x.
+template <class Centroids>
+int nearestCell(const Centroids& C, const Vec3& x) {
+  auto dist2 = [&](int i) {
+    return (C(i, 0) - x[0]) * (C(i, 0) - x[0]) + (C(i, 1) - x[1]) * (C(i, 1) - x[1]) +
+           (C(i, 2) - x[2]) * (C(i, 2) - x[2]);
+  };
+  int best = 0;
+  for (int c = 1; c < static_cast<int>(C.extent(0)); ++c)
+    if (dist2(c) < dist2(best)) best = c;
+  return best;
+}
+
 // Pressure at a point: on a patch, the boundary values of the two nearest faces blended by inverse
 // distance (they are extrapolated from the wall cells); otherwise the value of the nearest cell.
 double pressureAt(const FluidSolver& fluid, const Vec3& x, const std::string& patch) {
   if (!patch.empty()) return boundaryPressureAt(fluid, patch, x);
   auto C = Kokkos::create_mirror_view_and_copy(HostSpace(), fluid.geometry().cellCentroid);
   auto p = Kokkos::create_mirror_view_and_copy(HostSpace(), fluid.pressure());
-  auto dist = [&](int i) {
-    return std::sqrt((C(i, 0) - x[0]) * (C(i, 0) - x[0]) + (C(i, 1) - x[1]) * (C(i, 1) - x[1]) +
-                     (C(i, 2) - x[2]) * (C(i, 2) - x[2]));
-  };
-  int best = 0;
-  for (int c = 1; c < fluid.mesh().nCells(); ++c)
-    if (dist(c) < dist(best)) best = c;
-  return p(best);
+  return p(nearestCell(C, x));
 }
 
 double dot(const Vec3& a, const Vec3& b) { return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]; }
@@ -41,18 +46,7 @@ FluidModule::FluidModule(const HexMesh& mesh, const FluidOptions& options, Fluid
   probeValues_ = RealView("mfsi::fluid::probes::values", n);
   auto C = Kokkos::create_mirror_view_and_copy(HostSpace(), solver_.geometry().cellCentroid);
   auto h = Kokkos::create_mirror_view(probeCells_);
-  for (std::size_t i = 0; i < n; ++i) {
-    const Vec3& x = reports_.probes[i].point;
-    double best = std::numeric_limits<double>::max();
-    for (int c = 0; c < mesh.nCells(); ++c) {
-      const double d = (C(c, 0) - x[0]) * (C(c, 0) - x[0]) + (C(c, 1) - x[1]) * (C(c, 1) - x[1]) +
-                       (C(c, 2) - x[2]) * (C(c, 2) - x[2]);
-      if (d < best) {
-        best = d;
-        h(i) = c;
-      }
-    }
-  }
+  for (std::size_t i = 0; i < n; ++i) h(i) = nearestCell(C, reports_.probes[i].point);
   Kokkos::deep_copy(probeCells_, h);
 }
 

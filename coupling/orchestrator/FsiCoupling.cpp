@@ -163,6 +163,8 @@ void FsiCoupling::setUpBodies(const SceneConfig& section, std::vector<coupling::
 }
 
 void FsiCoupling::setUpParents(const SceneConfig& section) {
+  if (options_.parentBodyPatches.empty()) return;
+  auto pts = Kokkos::create_mirror_view_and_copy(HostSpace(), mesh_.points());  // the reference mesh
   std::vector<std::string> membraneNames;
   for (const Panel& p : panels_) {  // the scene's names: module "membrane.<name>" -> "<name>"
     const std::string& n = p.module->panel().name;
@@ -185,7 +187,6 @@ void FsiCoupling::setUpParents(const SceneConfig& section) {
                                                "'type: movingWall' instead of membraneWall");
     std::vector<std::array<real, 3>> candidates;
     std::vector<int> candidateBody;
-    auto pts = Kokkos::create_mirror_view_and_copy(HostSpace(), mesh_.points());
     for (std::size_t i = 0; i < pp.patches.size(); ++i) {
       const std::string& name = pp.patches[i];
       int slot = -1;
