@@ -3,7 +3,10 @@ MAKEFLAGS += --no-print-directory
 #   make run    set-up -> configure -> build -> run the default scene
 #   make test   set-up -> configure -> build -> ctest
 # Portability and correctness builds (scripts/build-variant.sh, each in its own build directory):
-#   make build-cuda    CUDA + OpenMP Kokkos, nvcc_wrapper: compiles and links every target (no GPU run)
+#   make build-cuda    CUDA + OpenMP Kokkos, nvcc_wrapper: compiles and links every library, the command
+#                      and the tests and benchmarks that write kernels (no GPU run)
+#   make test-checked  ASan + UBSan against a bounds-checked Kokkos in one build, the suite but its
+#                      longest accuracy runs (no benchmarks): what .ci/run uses
 #   make test-asan     AddressSanitizer + UndefinedBehaviorSanitizer build, the suite but its longest accuracy runs (no benchmarks)
 #   make test-bounds   Kokkos bounds-checked (debug) build, the suite but its longest accuracy runs (no benchmarks)
 # Options: BUILD_DIR=build  JOBS=<n>  SCENE=<file or name>  KOKKOS_ROOT=<your Kokkos>
@@ -18,7 +21,7 @@ ifdef KOKKOS_ROOT
   KOKKOS_ARG = -DKokkos_ROOT=$(KOKKOS_ROOT)
 endif
 
-.PHONY: all deps configure build run test bench clean build-cuda test-asan test-bounds
+.PHONY: all deps configure build run test bench clean build-cuda test-checked test-asan test-bounds
 
 all: build
 
@@ -44,6 +47,9 @@ bench: build
 build-cuda:
 	@JOBS=$(JOBS) bash scripts/build-variant.sh cuda
 
+test-checked:
+	@JOBS=$(JOBS) bash scripts/build-variant.sh checked --test
+
 test-asan:
 	@JOBS=$(JOBS) bash scripts/build-variant.sh asan --test
 
@@ -51,4 +57,4 @@ test-bounds:
 	@JOBS=$(JOBS) bash scripts/build-variant.sh bounds --test
 
 clean:
-	rm -rf $(BUILD_DIR) $(BUILD_DIR).deps.env build-cuda build-asan build-bounds
+	rm -rf $(BUILD_DIR) $(BUILD_DIR).deps.env build-cuda build-checked build-asan build-bounds

@@ -33,3 +33,38 @@ function(mfsi_library)
   install(DIRECTORY ${CMAKE_CURRENT_SOURCE_DIR}/ DESTINATION ${CMAKE_INSTALL_INCLUDEDIR}/mfsi/${L_NAME}
     FILES_MATCHING PATTERN "*.hpp")
 endfunction()
+
+# mfsi_builds_executable(<source> <out-var>)
+# Whether the test or benchmark of <source> is built: always, but under MFSI_KERNEL_TARGETS_ONLY
+# (the compile-only device build) only when <source>, or a "support/..." header it includes from
+# its own tree, writes a Kokkos kernel (a parallel dispatch or a device-annotated function): a
+# host-only test compiled by nvcc checks nothing that the main build and the libraries' device
+# compile do not.
+function(mfsi_builds_executable src out)
+  if(NOT MFSI_KERNEL_TARGETS_ONLY)
+    set(${out} TRUE PARENT_SCOPE)
+    return()
+  endif()
+  set(kernel_re "KOKKOS_LAMBDA|KOKKOS_CLASS_LAMBDA|KOKKOS_INLINE_FUNCTION|KOKKOS_FUNCTION|parallel_for|parallel_reduce|parallel_scan")
+  file(READ ${src} text)
+  set(found FALSE)
+  if(text MATCHES "${kernel_re}")
+    set(found TRUE)
+  else()
+    get_filename_component(dir ${src} DIRECTORY)
+    get_filename_component(root ${dir} DIRECTORY)
+    string(REGEX MATCHALL "#include \"support/[A-Za-z0-9_]+\\.hpp\"" incs "${text}")
+    foreach(inc ${incs})
+      string(REGEX REPLACE "#include \"(support/[A-Za-z0-9_]+\\.hpp)\"" "\\1" rel "${inc}")
+      foreach(base ${dir} ${root})
+        if(EXISTS ${base}/${rel})
+          file(READ ${base}/${rel} htext)
+          if(htext MATCHES "${kernel_re}")
+            set(found TRUE)
+          endif()
+        endif()
+      endforeach()
+    endforeach()
+  endif()
+  set(${out} ${found} PARENT_SCOPE)
+endfunction()

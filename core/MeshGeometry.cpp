@@ -50,6 +50,24 @@ void computeGeometry(const ExecSpace& exec, const HexMesh& mesh, const MeshGeome
       });
 }
 
+double minScaledJacobian(const ExecSpace& exec, const HexMesh& mesh) {
+  ConstReal3View pts = mesh.points();
+  ConstHex8View cn = mesh.cellNodes();
+  double jmin = 0;
+  Kokkos::parallel_reduce(
+      "mfsi::core::quality::minScaledJacobian", RangePolicy(exec, 0, mesh.nCells()),
+      KOKKOS_LAMBDA(lid_t c, double& m) {
+        double x[8][3];
+        for (int a = 0; a < 8; ++a)
+          for (int k = 0; k < 3; ++k) x[a][k] = pts(cn(c, a), k);
+        const double j = geom::hexMinScaledJacobian(x);
+        m = j < m ? j : m;
+      },
+      Kokkos::Min<double>(jmin));
+  exec.fence();
+  return jmin;
+}
+
 MeshQuality computeQuality(const ExecSpace& exec, const HexMesh& mesh, const MeshGeometry& geo) {
   ScopedRegion region("mfsi::core::quality");
   ConstReal3View pts = mesh.points();

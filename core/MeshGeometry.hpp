@@ -35,4 +35,8 @@ struct MeshQuality {
 /// Compute the quality of `mesh` given its computed geometry (fences, returns host values).
 MeshQuality computeQuality(const ExecSpace& exec, const HexMesh& mesh, const MeshGeometry& geo);
 
+/// The minimum scaled Jacobian over all cell corners at the current points (no geometry needed:
+/// one reduction; fences). The same value as `computeQuality(...).minScaledJacobian`.
+double minScaledJacobian(const ExecSpace& exec, const HexMesh& mesh);
+
 }  // namespace mfsi

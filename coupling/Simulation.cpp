@@ -58,6 +58,7 @@ Simulation::Simulation(const SceneConfig& scene) {
 
 void Simulation::meshMetrics(std::map<std::string, double>& m) const {
   if (!hasMesh_) return;
+  computeGeometry(ExecSpace(), mesh_, geometry_);  // the mesh may have moved since set-up
   const MeshQuality q = computeQuality(ExecSpace(), mesh_, geometry_);
   m["mesh.min_scaled_jacobian"] = q.minScaledJacobian;
   m["mesh.max_non_orthogonality_deg"] = q.maxNonOrthogonality;

@@ -127,14 +127,13 @@ void MeshSmoother::place(const ExecSpace& exec, const ConstReal3View& d) const {
       });
 }
 
-MotionReport MeshSmoother::move(const ExecSpace& exec, MeshGeometry& geo) {
+MotionReport MeshSmoother::move(const ExecSpace& exec) {
   ScopedRegion region("mfsi::coupling::motion");
   Kokkos::deep_copy(exec, start_, d_);  // prescribed values + the warm start
   MotionReport rep;
   auto measure = [&](int sweeps, int attempt, bool stiff) {
     place(exec, d_);
-    computeGeometry(exec, mesh_, geo);
-    rep = MotionReport{sweeps, attempt, stiff, computeQuality(exec, mesh_, geo).minScaledJacobian};
+    rep = MotionReport{sweeps, attempt, stiff, minScaledJacobian(exec, mesh_)};
   };
   if (options_.method == MeshMotionMethod::ConjugateGradient) {
     // Solved once, on the 1/L^2-weighted graph: on a graded mesh the plain graph Laplacian is
@@ -143,6 +142,7 @@ MotionReport MeshSmoother::move(const ExecSpace& exec, MeshGeometry& geo) {
     LaplacianCgOptions o;
     o.relTol = options_.relTol;
     o.maxIterations = options_.maxIterations;
+    o.preconditioner = options_.preconditioner;
     measure(laplacianCg(exec, stiff_, d_, cg_, o).iterations, 0, true);
   } else {
     for (int attempt = 0; attempt <= options_.retries; ++attempt) {
@@ -157,7 +157,6 @@ MotionReport MeshSmoother::move(const ExecSpace& exec, MeshGeometry& geo) {
   if (!(rep.minScaledJacobian > 0)) {
     Kokkos::deep_copy(exec, d_, good_);
     place(exec, d_);
-    computeGeometry(exec, mesh_, geo);
     exec.fence();
     std::ostringstream os;
     os << "mesh motion inverts a cell (minimum scaled Jacobian " << rep.minScaledJacobian << " after "

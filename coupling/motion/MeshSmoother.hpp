@@ -38,6 +38,8 @@ struct MeshSmootherOptions {
   MeshMotionMethod method = MeshMotionMethod::Jacobi;
   double relTol = 1e-3;      ///< CG: residual reduction per motion (warm-started: 1e-2 to 1e-8 give the cavity the same peak to 1e-6)
   int maxIterations = 2000;  ///< CG: iterations per motion
+  /// CG: the preconditioner (Jacobi: O(N) cheap iterations; AMG: a few V-cycles per component).
+  LaplacianPreconditioner preconditioner = LaplacianPreconditioner::Amg;
   /// Patches whose nodes slide along them (in the plane of the patch where it is flat) instead of
   /// staying put: walls next to a deflecting membrane, so the corner cells shear less.
   std::vector<std::string> slidingPatches;
@@ -64,10 +66,11 @@ class MeshSmoother {
   /// 1 for prescribed nodes.
   Kokkos::View<const std::uint8_t*, MemSpace> prescribed() const { return fixed_; }
 
-  /// Smooth, move the mesh points and recompute `geo`; the quality guard retries as the options
-  /// say. Throws DivergenceError when a cell is still inverted, with the mesh (points, geometry,
-  /// displacement) restored to the last accepted motion.
-  MotionReport move(const ExecSpace& exec, MeshGeometry& geo);
+  /// Smooth and move the mesh points; the quality guard (the minimum scaled Jacobian, from the
+  /// points alone) retries as the options say. The caller recomputes whatever geometry it keeps
+  /// (the fluid does, once per motion). Throws DivergenceError when a cell is still inverted, with
+  /// the mesh (points, displacement) restored to the last accepted motion.
+  MotionReport move(const ExecSpace& exec);
 
   /// Points = reference + d (one kernel; no fence).
   void place(const ExecSpace& exec, const ConstReal3View& d) const;

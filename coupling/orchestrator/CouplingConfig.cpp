@@ -18,6 +18,11 @@ Schema couplingSchema() {
                Default(o.motion.relTol))
           .key("maxIterations", Schema::integer("cg: iterations per motion").atLeast(1),
                Default(o.motion.maxIterations))
+          .key("preconditioner",
+               Schema::choice("cg: jacobi (the diagonal: many cheap iterations) or amg (smoothed-aggregation "
+                              "multigrid, set up once on the reference mesh: a few iterations at any size)",
+                              {"jacobi", "amg"}),
+               Default("amg"))
           .key("minScaledJacobian",
                Schema::real("quality guard: below this the motion is retried (more sweeps, then the stiffened "
                             "smoother); an inverted cell stops the run",
@@ -168,6 +173,8 @@ CouplingOptions readCouplingOptions(const SceneConfig& c) {
   o.motion.sweeps = c.get<int>("meshMotion.sweeps");
   o.motion.relTol = c.get<double>("meshMotion.relTol");
   o.motion.maxIterations = c.get<int>("meshMotion.maxIterations");
+  o.motion.preconditioner = c.get<std::string>("meshMotion.preconditioner") == "amg" ? LaplacianPreconditioner::Amg
+                                                                                   : LaplacianPreconditioner::Jacobi;
   o.motion.minScaledJacobian = c.get<double>("meshMotion.minScaledJacobian");
   o.motion.retries = c.get<int>("meshMotion.retries");
   o.motion.slidingPatches = c.get<std::vector<std::string>>("meshMotion.slidingPatches");

@@ -32,13 +32,11 @@ void toDevice(const InterfaceVector& x, Eigen::Index offset, const RealView& d) 
 
 }  // namespace
 
-FsiCoupling::FsiCoupling(const CouplingOptions& options, const SceneConfig& section, HexMesh& mesh,
-                         MeshGeometry& geometry, Timers& timers, std::unique_ptr<FluidModule> fluid,
+FsiCoupling::FsiCoupling(const CouplingOptions& options, const SceneConfig& section, HexMesh& mesh, Timers& timers, std::unique_ptr<FluidModule> fluid,
                          std::vector<std::unique_ptr<MembraneModule>> membranes, std::unique_ptr<RigidModule> rigid)
     : Module("coupling"),
       options_(options),
       mesh_(mesh),
-      geometry_(geometry),
       timers_(timers),
       fluid_(std::move(fluid)),
       ownedMembranes_(std::move(membranes)),
@@ -440,7 +438,7 @@ void FsiCoupling::moveMesh(const InterfaceVector& x) {
     coupling::MotionReport r;
     {
       ScopedTimer part(timers_, "coupling.motion.smoother");
-      r = smoother_->move(exec_, geometry_);
+      r = smoother_->move(exec_);
       exec_.fence();
     }
     last_.minScaledJacobian = std::min(last_.minScaledJacobian, r.minScaledJacobian);
@@ -644,7 +642,7 @@ ModuleEntry couplingModuleEntry() {
             }
             *ctx.built = std::move(rest);
             if (!fluid) throw InputError(section.where(), "the coupling needs the scene's 'fluid' section");
-            out.push_back(std::make_unique<FsiCoupling>(options, section, *ctx.mesh, *ctx.geometry, *ctx.timers,
+            out.push_back(std::make_unique<FsiCoupling>(options, section, *ctx.mesh, *ctx.timers,
                                                         std::move(fluid), std::move(membranes), std::move(rigid)));
             return out;
           }};

@@ -45,11 +45,10 @@ class FsiCoupling final : public Module {
  public:
   /// Couples `fluid` with every membrane in `membranes` (each cut from the fluid mesh) and with the
   /// bodies of `rigid` that options.bodyPatches names (rigid may be null without bodyPatches). The
-  /// mesh and its geometry (the scene's) must outlive the module. Throws InputError naming the
+  /// mesh (the scene's) must outlive the module; the fluid keeps its geometry. Throws InputError naming the
   /// section for membranes that are not on the fluid mesh, unknown bodies or patches, or fluid
   /// walls that cannot follow them.
-  FsiCoupling(const CouplingOptions& options, const SceneConfig& section, HexMesh& mesh, MeshGeometry& geometry,
-              Timers& timers, std::unique_ptr<FluidModule> fluid,
+  FsiCoupling(const CouplingOptions& options, const SceneConfig& section, HexMesh& mesh, Timers& timers, std::unique_ptr<FluidModule> fluid,
               std::vector<std::unique_ptr<MembraneModule>> membranes, std::unique_ptr<RigidModule> rigid = nullptr);
 
   void advance(const TimeState& t) override;
@@ -140,7 +139,6 @@ class FsiCoupling final : public Module {
 
   CouplingOptions options_;
   HexMesh& mesh_;
-  MeshGeometry& geometry_;
   Timers& timers_;
   ExecSpace exec_;
   std::unique_ptr<FluidModule> fluid_;

@@ -43,10 +43,9 @@ double firstCellThickness(int n, double gz) {
 
 TEST(MeshMotion, ZeroMotionLeavesAGradedMeshBitIdentical) {
   auto mesh = gradedBox(10, 8);
-  auto geo = mfsi::allocateGeometry(mesh);
   MeshSmoother s(mesh, MeshSmootherOptions{});
   mfsi::ExecSpace exec;
-  const auto rep = s.move(exec, geo);
+  const auto rep = s.move(exec);
   exec.fence();
   EXPECT_EQ(rep.retries, 0);
   auto hx = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), mesh.points());
@@ -59,11 +58,10 @@ TEST(MeshMotion, AWallDeflectionOfFiveCellThicknessesKeepsEveryCellValid) {
   const int n = 16;
   const double gz = 8, h0 = firstCellThickness(n, gz);
   auto mesh = gradedBox(n, gz);
-  auto geo = mfsi::allocateGeometry(mesh);
   MeshSmoother s(mesh, MeshSmootherOptions{});
   bottomBump(s, mesh, 5 * h0);
   mfsi::ExecSpace exec;
-  const auto rep = s.move(exec, geo);
+  const auto rep = s.move(exec);
   EXPECT_GT(rep.minScaledJacobian, MeshSmootherOptions{}.minScaledJacobian);
   // The wall really moved by 5 first-cell thicknesses at its centre (node at x = y = 0.5).
   auto hx = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), mesh.points());
@@ -78,19 +76,18 @@ TEST(MeshMotion, AWallDeflectionOfFiveCellThicknessesKeepsEveryCellValid) {
   noSweeps.retries = 0;
   MeshSmoother none(mesh, noSweeps);
   bottomBump(none, mesh, 5 * h0);
-  EXPECT_THROW(none.move(exec, geo), mfsi::DivergenceError);
+  EXPECT_THROW(none.move(exec), mfsi::DivergenceError);
 }
 
 TEST(MeshMotion, SolvedMotionLeavesAGradedMeshBitIdenticalAndKeepsALargeWallDeflectionValid) {
   const int n = 16;
   const double gz = 8, h0 = firstCellThickness(n, gz);
   auto mesh = gradedBox(n, gz);
-  auto geo = mfsi::allocateGeometry(mesh);
   MeshSmootherOptions o;
   o.method = mfsi::coupling::MeshMotionMethod::ConjugateGradient;
   MeshSmoother s(mesh, o);
   mfsi::ExecSpace exec;
-  EXPECT_EQ(s.move(exec, geo).sweeps, 0);
+  EXPECT_EQ(s.move(exec).sweeps, 0);
   auto hx = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), mesh.points());
   auto h0v = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), mesh.referencePoints());
   for (lid_t i = 0; i < mesh.nNodes(); ++i)
@@ -102,9 +99,9 @@ TEST(MeshMotion, SolvedMotionLeavesAGradedMeshBitIdenticalAndKeepsALargeWallDefl
   once.minScaledJacobian = 0;
   MeshSmoother sweeps(mesh, once);
   bottomBump(sweeps, mesh, 12 * h0);
-  EXPECT_THROW(sweeps.move(exec, geo), mfsi::DivergenceError) << "50 sweeps invert the first cell rows";
+  EXPECT_THROW(sweeps.move(exec), mfsi::DivergenceError) << "50 sweeps invert the first cell rows";
   bottomBump(s, mesh, 12 * h0);
-  const auto rep = s.move(exec, geo);
+  const auto rep = s.move(exec);
   std::printf("solved motion: min scaled Jacobian %.3f after %d CG iterations\n", rep.minScaledJacobian, rep.sweeps);
   EXPECT_GT(rep.minScaledJacobian, 0.3);
   EXPECT_EQ(rep.retries, 0);
@@ -112,17 +109,16 @@ TEST(MeshMotion, SolvedMotionLeavesAGradedMeshBitIdenticalAndKeepsALargeWallDefl
 
 TEST(MeshMotion, AnImpossibleMotionIsRefusedAndTheMeshKeptAsItWas) {
   auto mesh = gradedBox(8, 4);
-  auto geo = mfsi::allocateGeometry(mesh);
   MeshSmoother s(mesh, MeshSmootherOptions{});
   mfsi::ExecSpace exec;
   bottomBump(s, mesh, 0.05);  // an accepted motion first
-  s.move(exec, geo);
+  s.move(exec);
   exec.fence();
   // Own host copies (a mirror of a host View would be the mesh's points themselves).
   Kokkos::View<double* [3], Kokkos::HostSpace> before("before", mesh.nNodes()), after("after", mesh.nNodes());
   Kokkos::deep_copy(before, mesh.points());
   bottomBump(s, mesh, 1.5);  // through the fixed top wall: no interior motion can save it
-  EXPECT_THROW(s.move(exec, geo), mfsi::DivergenceError);
+  EXPECT_THROW(s.move(exec), mfsi::DivergenceError);
   Kokkos::deep_copy(after, mesh.points());
   for (lid_t i = 0; i < mesh.nNodes(); ++i)
     for (int c = 0; c < 3; ++c) ASSERT_EQ(after(i, c), before(i, c)) << "node " << i;
