@@ -18,9 +18,7 @@ void sweptVolumes(const ExecSpace& exec, const HexMesh& mesh, const ConstReal3Vi
             x[a][k] = oldPoints(fn(f, a), k);
             x[a + 4][k] = newPoints(fn(f, a), k);
           }
-        double v, c[3];
-        geom::hexVolumeCentroid(x, v, c);
-        swept(f) = v;
+        swept(f) = geom::hexVolume(x);
       });
 }
 
