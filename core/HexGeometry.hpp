@@ -76,34 +76,10 @@ KOKKOS_INLINE_FUNCTION void quadCentroid(const double x[4][3], double c[3], doub
   }
 }
 
-/// Exact volume of a trilinear hex (VTK node order), in closed form. With the map written as
-/// x = e0 + e1 xi + e2 eta + e3 zeta + e4 xi eta + e5 eta zeta + e6 zeta xi + e7 xi eta zeta on
-/// [-1, 1]^3 (e_k = 1/8 sum_q s_kq x_q, s_kq the products of the node's signs), the integral of
-/// det J is 8 [e1, e2, e3] + 8/3 ([e1, e4, e6] - [e2, e4, e5] - [e3, e5, e6]) ([a, b, c] the
-/// triple product; every other term integrates to zero, e7 and e0 drop out). The same value as
-/// `hexVolumeCentroid`'s Gauss sum to round-off, at about a seventh of its cost.
-KOKKOS_INLINE_FUNCTION double hexVolume(const double x[8][3]) {
-  double e[6][3];
-  for (int k = 0; k < 3; ++k) {
-    const double p0 = x[0][k], p1 = x[1][k], p2 = x[2][k], p3 = x[3][k];
-    const double p4 = x[4][k], p5 = x[5][k], p6 = x[6][k], p7 = x[7][k];
-    e[0][k] = 0.125 * (-p0 + p1 + p2 - p3 - p4 + p5 + p6 - p7);  // xi
-    e[1][k] = 0.125 * (-p0 - p1 + p2 + p3 - p4 - p5 + p6 + p7);  // eta
-    e[2][k] = 0.125 * (-p0 - p1 - p2 - p3 + p4 + p5 + p6 + p7);  // zeta
-    e[3][k] = 0.125 * (p0 - p1 + p2 - p3 + p4 - p5 + p6 - p7);   // xi eta
-    e[4][k] = 0.125 * (p0 + p1 - p2 - p3 - p4 - p5 + p6 + p7);   // eta zeta
-    e[5][k] = 0.125 * (p0 - p1 - p2 + p3 - p4 + p5 + p6 - p7);   // zeta xi
-  }
-  return 8.0 * det3(e[0], e[1], e[2]) +
-         (8.0 / 3.0) * (det3(e[0], e[3], e[5]) - det3(e[1], e[3], e[4]) - det3(e[2], e[4], e[5]));
-}
-
-/// Exact volume and centroid of a trilinear hex (VTK node order): the 2x2x2 Gauss sums of det J
-/// and x det J (exact: det J has degree <= 2 in each coordinate, x det J <= 3), with x and J at
-/// each point formed from the map's coefficients e_k (see `hexVolume`) instead of the eight shape
-/// functions: about half the operations of the nodal form.
-KOKKOS_INLINE_FUNCTION void hexVolumeCentroid(const double x[8][3], double& vol, double c[3]) {
-  double e[8][3];
+/// Coefficients of a trilinear hex's map (VTK node order) on [-1, 1]^3:
+/// x = e0 + e1 xi + e2 eta + e3 zeta + e4 xi eta + e5 eta zeta + e6 zeta xi + e7 xi eta zeta,
+/// e_k = 1/8 sum_q s_kq x_q with s_kq the product of node q's signs in the monomial's variables.
+KOKKOS_INLINE_FUNCTION void hexMapCoefficients(const double x[8][3], double e[8][3]) {
   for (int k = 0; k < 3; ++k) {
     const double p0 = x[0][k], p1 = x[1][k], p2 = x[2][k], p3 = x[3][k];
     const double p4 = x[4][k], p5 = x[5][k], p6 = x[6][k], p7 = x[7][k];
@@ -116,6 +92,26 @@ KOKKOS_INLINE_FUNCTION void hexVolumeCentroid(const double x[8][3], double& vol,
     e[6][k] = 0.125 * (p0 - p1 - p2 + p3 - p4 + p5 + p6 - p7);   // zeta xi
     e[7][k] = 0.125 * (-p0 + p1 - p2 + p3 + p4 - p5 + p6 - p7);  // xi eta zeta
   }
+}
+
+/// Exact volume of a trilinear hex (VTK node order), in closed form. With the map's coefficients
+/// (`hexMapCoefficients`), the integral of det J is 8 [e1, e2, e3] + 8/3 ([e1, e4, e6] - [e2, e4, e5] - [e3, e5, e6]) ([a, b, c] the
+/// triple product; every other term integrates to zero, e7 and e0 drop out). The same value as
+/// `hexVolumeCentroid`'s Gauss sum to round-off, at about a seventh of its cost.
+KOKKOS_INLINE_FUNCTION double hexVolume(const double x[8][3]) {
+  double e[8][3];
+  hexMapCoefficients(x, e);
+  return 8.0 * det3(e[1], e[2], e[3]) +
+         (8.0 / 3.0) * (det3(e[1], e[4], e[6]) - det3(e[2], e[4], e[5]) - det3(e[3], e[5], e[6]));
+}
+
+/// Exact volume and centroid of a trilinear hex (VTK node order): the 2x2x2 Gauss sums of det J
+/// and x det J (exact: det J has degree <= 2 in each coordinate, x det J <= 3), with x and J at
+/// each point formed from the map's coefficients e_k (`hexMapCoefficients`) instead of the eight shape
+/// functions: about half the operations of the nodal form.
+KOKKOS_INLINE_FUNCTION void hexVolumeCentroid(const double x[8][3], double& vol, double c[3]) {
+  double e[8][3];
+  hexMapCoefficients(x, e);
   const double g = 0.57735026918962576451;
   vol = 0.0;
   c[0] = c[1] = c[2] = 0.0;
