@@ -149,7 +149,11 @@ int commandRun(const std::string& sceneArg, const std::vector<std::string>& sets
     std::cerr << "internal error: " << e.what() << "\n";
     code = 1;
   }
-  if (sim) summary.timers = sim->timers().all();
+  if (sim) {
+    summary.timers = sim->timers().all();
+    summary.steps = sim->completedSteps();  // how far a diverged run got
+    summary.simTime = sim->completedTime();
+  }
   summary.wallSeconds = mfsi::wallSeconds() - t0;
   if (rank == 0) {
     try {

@@ -97,6 +97,8 @@ RunResult Simulation::run(const std::string& outDir, bool terminal) {
     }
     ts.time += ts.dt;
     ++ts.step;
+    completedSteps_ = ts.step;
+    completedTime_ = ts.time;
     std::vector<double> row = {double(ts.step), ts.time, wallSeconds() - start};
     for (const Module* m : reporting_) m->appendStepValues(row);
     log.row(row);

@@ -37,6 +37,10 @@ class Simulation {
   const std::vector<std::unique_ptr<Module>>& modules() const { return modules_; }
   Timers& timers() { return timers_; }
   const TimeOptions& timeOptions() const { return time_; }
+  /// Steps completed and the time they reached, also when `run` stopped with an exception (a
+  /// diverged run reports how far it got).
+  long long completedSteps() const { return completedSteps_; }
+  double completedTime() const { return completedTime_; }
 
  private:
   void meshMetrics(std::map<std::string, double>& m) const;
@@ -48,6 +52,8 @@ class Simulation {
   TimeOptions time_;
   std::vector<std::unique_ptr<Module>> modules_;  ///< advanced by the driver
   std::vector<Module*> reporting_;                ///< modules_ and their parts: output, columns, metrics
+  long long completedSteps_ = 0;
+  double completedTime_ = 0;
 };
 
 }  // namespace mfsi
