@@ -460,6 +460,53 @@ void FluidSolver::beginStep(real t, real dt) {
   // New prescribed pressures (time functions) change the boundary values the gradient sees.
   if (bc_.fixesPressureLevel()) gradPValid_ = false;
   updateBoundaryVelocity();
+  if (stepStart_.enabled) takeStepStart();
+}
+
+void FluidSolver::takeStepStart() {
+  StepStartIterate& s = stepStart_;
+  if (s.U.extent(0) != U_.extent(0)) {
+    s.U = Real3View("mfsi::fluid::stepStart::U", U_.extent(0));
+    s.p = RealView("mfsi::fluid::stepStart::p", p_.extent(0));
+    s.phi = RealView("mfsi::fluid::stepStart::phi", phi_.extent(0));
+  }
+  if (s.dpFinal.extent(0) != dpFinal_.extent(0)) s.dpFinal = RealView("mfsi::fluid::stepStart::dpFinal", dpFinal_.extent(0));
+  Kokkos::deep_copy(exec_, s.U, U_);
+  Kokkos::deep_copy(exec_, s.p, p_);
+  Kokkos::deep_copy(exec_, s.phi, phi_);
+  if (s.gradP.extent(0) != gradP_.extent(0)) s.gradP = Real3View("mfsi::fluid::stepStart::gradP", gradP_.extent(0));
+  Kokkos::deep_copy(exec_, s.gradP, gradP_);
+  if (dpFinal_.extent(0) > 0) Kokkos::deep_copy(exec_, s.dpFinal, dpFinal_);
+  s.dpFinalValid = dpFinalValid_;
+  // Every solve from the step's start refreshes the pressure preconditioner at its first assembly,
+  // so that it does not depend on the meshes solved on before (a coupling moves the mesh between
+  // solves anyway, which changes the matrix).
+  pressureRefreshDue_ = true;
+  s.pressureAssemblies = pressureAssemblies_;
+  s.refreshBaselineIterations = refreshBaselineIterations_;
+  s.pressureRefreshDue = pressureRefreshDue_;
+  s.valid = true;
+}
+
+void FluidSolver::restoreStepStart() {
+  const StepStartIterate& s = stepStart_;
+  MFSI_CHECK(s.valid, "fluid: restoreStepStart without keepStepStart(true) before beginStep");
+  Kokkos::deep_copy(exec_, U_, s.U);
+  Kokkos::deep_copy(exec_, p_, s.p);
+  Kokkos::deep_copy(exec_, phi_, s.phi);
+  Kokkos::deep_copy(exec_, gradP_, s.gradP);
+  // dpFinal_ is allocated by the first final pressure solve: a snapshot taken before it has none.
+  if (s.dpFinal.extent(0) > 0 && s.dpFinal.extent(0) == dpFinal_.extent(0)) Kokkos::deep_copy(exec_, dpFinal_, s.dpFinal);
+  dpFinalValid_ = s.dpFinalValid && s.dpFinal.extent(0) > 0;
+  pressureAssemblies_ = s.pressureAssemblies;
+  refreshBaselineIterations_ = s.refreshBaselineIterations;
+  pressureRefreshDue_ = s.pressureRefreshDue;
+  // What solve() derives from the iterate: recomputed from the restored fields.
+  freshStep_ = true;
+  dphiLatest_ = false;
+  gradPValid_ = false;
+  gradUCurrent_ = false;
+  updateBoundaryVelocity();
 }
 
 void FluidSolver::moveMesh(const ConstReal3View& newPoints) {

@@ -84,6 +84,13 @@ class FluidSolver {
   StepResult solveStep(real t, real dt);
   /// \brief Mesh motion used by `solveStep`.
   void setMeshMotion(MeshMotion motion) { motion_ = std::move(motion); }
+  /// \brief Keep the iterate at the start of every step (`beginStep`), so that `restoreStepStart`
+  /// can put it back: for a coupling that re-solves a step and wants each solve to depend on its
+  /// interface data alone, not on the iterations before it. Off by default (one copy per step).
+  void keepStepStart(bool keep) { stepStart_.enabled = keep; }
+  /// \brief Put back the velocity, pressure, face fluxes and the solver guesses of the start of the
+  /// current step (`keepStepStart(true)` before its `beginStep`); the mesh stays where it is.
+  void restoreStepStart();
 
   // --- boundary input ------------------------------------------------------------------------
   /// \brief Per-face wall velocity for a wall patch with `WallMotion::External`, or for both sides
@@ -269,6 +276,20 @@ class FluidSolver {
   mutable bool gradUCurrent_ = false;  ///< a resistance outlet changes the boundary pressure every corrector
   real c1_ = 0, c0_ = 0, c00_ = 0;     ///< time weights: d(phi)/dt ~ (c1 phi - c0 phi0 + c00 phi00)/dt
   MeshMotion motion_;
+  /// \brief The iterate at the start of the step and the solver state a solve reads besides it.
+  struct StepStartIterate {
+    bool enabled = false;
+    bool valid = false;  ///< taken at the last beginStep
+    Real3View U;
+    Real3View gradP;  ///< the last corrector's pressure gradient, which the first outer iteration reads
+    RealView p, phi, dpFinal;
+    bool dpFinalValid = false;
+    long pressureAssemblies = 0;
+    int refreshBaselineIterations = -1;
+    bool pressureRefreshDue = false;
+  };
+  StepStartIterate stepStart_;
+  void takeStepStart();
 };
 
 }  // namespace mfsi::fluid

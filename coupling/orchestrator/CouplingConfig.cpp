@@ -114,6 +114,12 @@ Schema couplingSchema() {
                         "-")
                .atLeast(0),
            Default(o.maxDeltaDispFrac))
+      .key("fluidStart",
+           Schema::choice("where each coupling iteration's fluid solve starts: lastIterate (the previous "
+                          "iteration's answer, fewer outer iterations) or stepStart (the step's start: the "
+                          "fluid's answer depends on the interface alone)",
+                          {"lastIterate", "stepStart"}),
+           Default("lastIterate"))
       .key("viscousTraction",
            Schema::boolean("load the membranes with the fluid's viscous traction too (nodal forces), not the "
                            "pressure alone"),
@@ -166,6 +172,7 @@ CouplingOptions readCouplingOptions(const SceneConfig& c) {
   o.pClamp = c.get<double>("pClamp");
   o.outsidePressure = c.get<double>("outsidePressure");
   o.viscousTraction = c.get<bool>("viscousTraction");
+  o.fluidFromStepStart = c.get<std::string>("fluidStart") == "stepStart";
   o.maxMeshVelocity = c.get<double>("maxMeshVelocity");
   o.maxDeltaDispFrac = c.get<double>("maxDeltaDispFrac");
   o.motion.method = c.get<std::string>("meshMotion.method") == "jacobi" ? coupling::MeshMotionMethod::Jacobi

@@ -61,6 +61,10 @@ struct CouplingOptions {
   /// characteristic length sqrt(reference area) (0: off): the seed's bow-limiter.
   double maxDeltaDispFrac = 0;
   bool viscousTraction = false;  ///< add the fluid's viscous traction to the membrane loads
+  /// Every coupling iteration's fluid solve starts from the step's start iterate (true) instead of
+  /// the last iteration's answer: the fluid's answer is then a function of the interface alone,
+  /// also where the fluid does not converge within its outer iterations.
+  bool fluidFromStepStart = false;
   coupling::MeshSmootherOptions motion;
   /// \brief A rigid body of the `bodies` section and the fluid patches that move with it.
   struct BodyPatches {

@@ -42,6 +42,7 @@ FsiCoupling::FsiCoupling(const CouplingOptions& options, const SceneConfig& sect
       ownedMembranes_(std::move(membranes)),
       rigid_(std::move(rigid)) {
   MFSI_CHECK(fluid_, "coupling: no fluid module");
+  fluid_->solver().keepStepStart(options_.fluidFromStepStart);
   if (ownedMembranes_.empty() && options_.bodyPatches.empty())
     throw InputError(section.where(), "the coupling needs at least one membrane cut from the fluid mesh "
                                       "(membranes.N.mesh: baffles or boundaryPatch) or a rigid body (bodyPatches)");
@@ -476,6 +477,7 @@ bool FsiCoupling::moveMeshGuarded(InterfaceVector& x, InterfaceVector& good) {
 
 void FsiCoupling::solveFluid(const TimeState& t) {
   ScopedTimer timer(timers_, "coupling.fluid");
+  if (options_.fluidFromStepStart && last_.iterations > 0) fluid_->solver().restoreStepStart();
   fluid_->solveIteration(t);
   ++last_.iterations;
 }
