@@ -95,8 +95,9 @@ KOKKOS_INLINE_FUNCTION void hexMapCoefficients(const double x[8][3], double e[8]
 }
 
 /// Exact volume of a trilinear hex (VTK node order), in closed form. With the map's coefficients
-/// (`hexMapCoefficients`), the integral of det J is 8 [e1, e2, e3] + 8/3 ([e1, e4, e6] - [e2, e4, e5] - [e3, e5, e6]) ([a, b, c] the
-/// triple product; every other term integrates to zero, e7 and e0 drop out). The same value as
+/// (`hexMapCoefficients`), the integral of det J is
+/// 8 [e1, e2, e3] + 8/3 ([e1, e4, e6] - [e2, e4, e5] - [e3, e5, e6]) ([a, b, c] the triple product;
+/// every other term integrates to zero, e7 and e0 drop out). The same value as
 /// `hexVolumeCentroid`'s Gauss sum to round-off, at about a seventh of its cost.
 KOKKOS_INLINE_FUNCTION double hexVolume(const double x[8][3]) {
   double e[8][3];
@@ -107,8 +108,8 @@ KOKKOS_INLINE_FUNCTION double hexVolume(const double x[8][3]) {
 
 /// Exact volume and centroid of a trilinear hex (VTK node order): the 2x2x2 Gauss sums of det J
 /// and x det J (exact: det J has degree <= 2 in each coordinate, x det J <= 3), with x and J at
-/// each point formed from the map's coefficients e_k (`hexMapCoefficients`) instead of the eight shape
-/// functions: about half the operations of the nodal form.
+/// each point formed from the map's coefficients e_k (`hexMapCoefficients`) instead of the eight
+/// shape functions: about half the operations of the nodal form.
 KOKKOS_INLINE_FUNCTION void hexVolumeCentroid(const double x[8][3], double& vol, double c[3]) {
   double e[8][3];
   hexMapCoefficients(x, e);

@@ -70,24 +70,17 @@ double minScaledJacobian(const ExecSpace& exec, const HexMesh& mesh) {
 
 MeshQuality computeQuality(const ExecSpace& exec, const HexMesh& mesh, const MeshGeometry& geo) {
   ScopedRegion region("mfsi::core::quality");
-  ConstReal3View pts = mesh.points();
-  ConstHex8View cn = mesh.cellNodes();
   ConstRealView vol = geo.cellVolume;
   MeshQuality q;
+  q.minScaledJacobian = minScaledJacobian(exec, mesh);
   Kokkos::parallel_reduce(
       "mfsi::core::quality::cells", RangePolicy(exec, 0, mesh.nCells()),
-      KOKKOS_LAMBDA(lid_t c, double& jmin, double& vsum, double& vmin, double& vmax) {
-        double x[8][3];
-        for (int a = 0; a < 8; ++a)
-          for (int k = 0; k < 3; ++k) x[a][k] = pts(cn(c, a), k);
-        const double j = geom::hexMinScaledJacobian(x);
-        jmin = j < jmin ? j : jmin;
+      KOKKOS_LAMBDA(lid_t c, double& vsum, double& vmin, double& vmax) {
         vsum += vol(c);
         vmin = vol(c) < vmin ? vol(c) : vmin;
         vmax = vol(c) > vmax ? vol(c) : vmax;
       },
-      Kokkos::Min<double>(q.minScaledJacobian), q.totalVolume, Kokkos::Min<double>(q.minVolume),
-      Kokkos::Max<double>(q.maxVolume));
+      q.totalVolume, Kokkos::Min<double>(q.minVolume), Kokkos::Max<double>(q.maxVolume));
 
   ConstIndexView own = mesh.faceOwner();
   ConstIndexView nei = mesh.faceNeighbour();

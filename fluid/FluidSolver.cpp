@@ -5,6 +5,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <string>
 #include <utility>
 
 namespace mfsi::fluid {
@@ -463,28 +464,29 @@ void FluidSolver::beginStep(real t, real dt) {
   if (stepStart_.enabled) takeStepStart();
 }
 
+namespace {
+/// dst <- src, (re)allocating dst to src's size first.
+template <class V>
+void keepCopy(const ExecSpace& exec, V& dst, const V& src, const char* label) {
+  if (dst.extent(0) != src.extent(0)) dst = V(std::string(label), src.extent(0));
+  if (src.extent(0) > 0) Kokkos::deep_copy(exec, dst, src);
+}
+}  // namespace
+
 void FluidSolver::takeStepStart() {
   StepStartIterate& s = stepStart_;
-  if (s.U.extent(0) != U_.extent(0)) {
-    s.U = Real3View("mfsi::fluid::stepStart::U", U_.extent(0));
-    s.p = RealView("mfsi::fluid::stepStart::p", p_.extent(0));
-    s.phi = RealView("mfsi::fluid::stepStart::phi", phi_.extent(0));
-  }
-  if (s.dpFinal.extent(0) != dpFinal_.extent(0)) s.dpFinal = RealView("mfsi::fluid::stepStart::dpFinal", dpFinal_.extent(0));
-  Kokkos::deep_copy(exec_, s.U, U_);
-  Kokkos::deep_copy(exec_, s.p, p_);
-  Kokkos::deep_copy(exec_, s.phi, phi_);
-  if (s.gradP.extent(0) != gradP_.extent(0)) s.gradP = Real3View("mfsi::fluid::stepStart::gradP", gradP_.extent(0));
-  Kokkos::deep_copy(exec_, s.gradP, gradP_);
-  if (dpFinal_.extent(0) > 0) Kokkos::deep_copy(exec_, s.dpFinal, dpFinal_);
+  keepCopy(exec_, s.U, U_, "mfsi::fluid::stepStart::U");
+  keepCopy(exec_, s.p, p_, "mfsi::fluid::stepStart::p");
+  keepCopy(exec_, s.phi, phi_, "mfsi::fluid::stepStart::phi");
+  keepCopy(exec_, s.gradP, gradP_, "mfsi::fluid::stepStart::gradP");
+  keepCopy(exec_, s.dpFinal, dpFinal_, "mfsi::fluid::stepStart::dpFinal");
   s.dpFinalValid = dpFinalValid_;
+  s.pressureAssemblies = pressureAssemblies_;
+  s.refreshBaselineIterations = refreshBaselineIterations_;
   // Every solve from the step's start refreshes the pressure preconditioner at its first assembly,
   // so that it does not depend on the meshes solved on before (a coupling moves the mesh between
   // solves anyway, which changes the matrix).
   pressureRefreshDue_ = true;
-  s.pressureAssemblies = pressureAssemblies_;
-  s.refreshBaselineIterations = refreshBaselineIterations_;
-  s.pressureRefreshDue = pressureRefreshDue_;
   s.valid = true;
 }
 
@@ -496,11 +498,12 @@ void FluidSolver::restoreStepStart() {
   Kokkos::deep_copy(exec_, phi_, s.phi);
   Kokkos::deep_copy(exec_, gradP_, s.gradP);
   // dpFinal_ is allocated by the first final pressure solve: a snapshot taken before it has none.
-  if (s.dpFinal.extent(0) > 0 && s.dpFinal.extent(0) == dpFinal_.extent(0)) Kokkos::deep_copy(exec_, dpFinal_, s.dpFinal);
-  dpFinalValid_ = s.dpFinalValid && s.dpFinal.extent(0) > 0;
+  const bool hadGuess = s.dpFinal.extent(0) > 0 && s.dpFinal.extent(0) == dpFinal_.extent(0);
+  if (hadGuess) Kokkos::deep_copy(exec_, dpFinal_, s.dpFinal);
+  dpFinalValid_ = s.dpFinalValid && hadGuess;
   pressureAssemblies_ = s.pressureAssemblies;
   refreshBaselineIterations_ = s.refreshBaselineIterations;
-  pressureRefreshDue_ = s.pressureRefreshDue;
+  pressureRefreshDue_ = true;  // as at the step's start (takeStepStart)
   // What solve() derives from the iterate: recomputed from the restored fields.
   freshStep_ = true;
   dphiLatest_ = false;

@@ -286,7 +286,6 @@ class FluidSolver {
     bool dpFinalValid = false;
     long pressureAssemblies = 0;
     int refreshBaselineIterations = -1;
-    bool pressureRefreshDue = false;
   };
   StepStartIterate stepStart_;
   void takeStepStart();

@@ -127,7 +127,8 @@ void allocateAmg(const ExecSpace& exec, const SmoothingGraph& g, LaplacianCgWork
 }
 
 /// z = P M^{-1} P r with M the AMG cycle of each component on its free nodes and P the projection
-/// on the free space (zero at fixed nodes, the plane at sliding nodes); returns r . z.
+/// on the free space (zero at fixed nodes: held in every component, never written; the plane at
+/// sliding nodes); returns r . z.
 double amgPrecondition(const ExecSpace& exec, const SmoothingGraph& g, LaplacianCgWork& w) {
   const lid_t n = g.nNodes();
   const Real3View r = w.r, z = w.z;
@@ -147,13 +148,10 @@ double amgPrecondition(const ExecSpace& exec, const SmoothingGraph& g, Laplacian
   }
   const ConstReal3View sn = g.slideNormal;
   const bool sliding = sn.extent(0) > 0;
-  const auto fixed = g.fixed;
   const SolverComm comm;
   return blas::reduce<1>(exec, comm, "mfsi::kernels::laplacianCg::project", n,
                          KOKKOS_LAMBDA(lid_t i, blas::Sums<1> & acc) {
-                           if (fixed(i) != 0) {
-                             for (int c = 0; c < 3; ++c) z(i, c) = 0;
-                           } else if (sliding) {
+                           if (sliding) {
                              const real zn = z(i, 0) * sn(i, 0) + z(i, 1) * sn(i, 1) + z(i, 2) * sn(i, 2);
                              for (int c = 0; c < 3; ++c) z(i, c) -= zn * sn(i, c);
                            }

@@ -14,8 +14,9 @@
 ///
 /// Preconditioners: the diagonal (Jacobi: one fused kernel per iteration, O(N) iterations), or a
 /// smoothed-aggregation AMG V-cycle per component (kernels/Amg.hpp) on the scalar graph Laplacian
-/// of the free nodes: a few iterations at any size, each ~ten kernels per component. The graph's weights are those of the reference mesh, so the AMG is set up once, on
-/// first use, and kept in the work struct. A sliding node is held, for the AMG, in the component
+/// of the free nodes: a few iterations at any size, each ~ten kernels per component. The graph's
+/// weights are those of the reference mesh, so the AMG is set up once, on first use, and kept in
+/// the work struct. A sliding node is held, for the AMG, in the component
 /// its plane's normal points along, and the preconditioned residual is projected on its plane (the
 /// operator's range there), so CG stays in the constrained space.
 #include "kernels/Amg.hpp"

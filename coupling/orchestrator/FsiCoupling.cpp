@@ -32,8 +32,9 @@ void toDevice(const InterfaceVector& x, Eigen::Index offset, const RealView& d) 
 
 }  // namespace
 
-FsiCoupling::FsiCoupling(const CouplingOptions& options, const SceneConfig& section, HexMesh& mesh, Timers& timers, std::unique_ptr<FluidModule> fluid,
-                         std::vector<std::unique_ptr<MembraneModule>> membranes, std::unique_ptr<RigidModule> rigid)
+FsiCoupling::FsiCoupling(const CouplingOptions& options, const SceneConfig& section, HexMesh& mesh, Timers& timers,
+                         std::unique_ptr<FluidModule> fluid, std::vector<std::unique_ptr<MembraneModule>> membranes,
+                         std::unique_ptr<RigidModule> rigid)
     : Module("coupling"),
       options_(options),
       mesh_(mesh),

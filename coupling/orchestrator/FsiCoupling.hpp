@@ -45,11 +45,12 @@ class FsiCoupling final : public Module {
  public:
   /// Couples `fluid` with every membrane in `membranes` (each cut from the fluid mesh) and with the
   /// bodies of `rigid` that options.bodyPatches names (rigid may be null without bodyPatches). The
-  /// mesh (the scene's) must outlive the module; the fluid keeps its geometry. Throws InputError naming the
-  /// section for membranes that are not on the fluid mesh, unknown bodies or patches, or fluid
-  /// walls that cannot follow them.
-  FsiCoupling(const CouplingOptions& options, const SceneConfig& section, HexMesh& mesh, Timers& timers, std::unique_ptr<FluidModule> fluid,
-              std::vector<std::unique_ptr<MembraneModule>> membranes, std::unique_ptr<RigidModule> rigid = nullptr);
+  /// mesh (the scene's) must outlive the module; the fluid keeps its geometry. Throws InputError
+  /// naming the section for membranes that are not on the fluid mesh, unknown bodies or patches, or
+  /// fluid walls that cannot follow them.
+  FsiCoupling(const CouplingOptions& options, const SceneConfig& section, HexMesh& mesh, Timers& timers,
+              std::unique_ptr<FluidModule> fluid, std::vector<std::unique_ptr<MembraneModule>> membranes,
+              std::unique_ptr<RigidModule> rigid = nullptr);
 
   void advance(const TimeState& t) override;
   void addMetrics(std::map<std::string, double>& metrics) const override;
