@@ -2,6 +2,7 @@
 # (staggered) scheme blows up within a few steps. `mfsi run` must exit with code 3, write
 # summary.json with status "diverged", the reason, and the steps it completed with the time they
 # reached, and steps.csv must hold exactly those steps.
+include(${CMAKE_CURRENT_LIST_DIR}/support/summary.cmake)
 file(REMOVE_RECURSE ${WORK})
 set(out ${WORK}/piston_explicit)
 execute_process(COMMAND ${MFSI} run ${CASES}/piston.yaml --set coupling.scheme=explicit --out ${out} --threads 1
@@ -9,19 +10,10 @@ execute_process(COMMAND ${MFSI} run ${CASES}/piston.yaml --set coupling.scheme=e
 if(NOT rc EQUAL 3)
   message(FATAL_ERROR "exit code ${rc}, expected 3 (diverged)\n${e}")
 endif()
-file(READ ${out}/summary.json js)
-foreach(key status error steps sim_time)
-  string(JSON ${key} GET "${js}" ${key})
-endforeach()
-set(err "${error}")
-set(simTime "${sim_time}")
-if(NOT status STREQUAL "diverged")
-  message(SEND_ERROR "status '${status}', expected 'diverged'")
-endif()
-string(FIND "${err}" "t = " pos)
-if(pos EQUAL -1)
-  message(SEND_ERROR "the reason does not name the step's time: ${err}")
-endif()
+mfsi_expect_summary(${out} diverged "t = " "explicit piston (the reason must name the step's time)")
+set(err "${summary_error}")
+set(steps "${summary_steps}")
+set(simTime "${summary_sim_time}")
 if(steps LESS 1 OR steps GREATER 50)
   message(SEND_ERROR "steps ${steps}: expected the few steps before the blow-up")
 endif()
