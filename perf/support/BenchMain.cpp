@@ -1,5 +1,7 @@
 #include "support/BenchMain.hpp"
 
+#include "core/MpiStart.hpp"
+
 #include <mpi.h>
 
 #include <cstdlib>
@@ -20,7 +22,7 @@ void setRates(benchmark::State& state, double bytesPerIter, double itemsPerIter,
 }  // namespace mfsi::bench
 
 int main(int argc, char** argv) {
-  MPI_Init(&argc, &argv);
+  mfsi::mpiInit(&argc, &argv);
   {
     Kokkos::ScopeGuard kokkos(argc, argv);
     benchmark::AddCustomContext("kokkos_backend", Kokkos::DefaultExecutionSpace::name());

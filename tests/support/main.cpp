@@ -1,4 +1,6 @@
 // Test entry point: MPI and Kokkos are initialised once for every test in the executable.
+#include "core/MpiStart.hpp"
+
 #include <gtest/gtest.h>
 #include <mpi.h>
 
@@ -6,7 +8,7 @@
 #include <vector>
 
 int main(int argc, char** argv) {
-  MPI_Init(&argc, &argv);
+  mfsi::mpiInit(&argc, &argv);
   int rc = 0;
   {
     // Test discovery parses stdout, so Kokkos' start-up warnings (e.g. OMP_PROC_BIND) stay quiet.
