@@ -8,7 +8,8 @@
 //   mfsi scenes                               # built-in scenes
 //   mfsi --version
 //
-// Exit codes: 0 ok, 2 bad input (scene, mesh, command line), 3 diverged, 1 internal error.
+// Exit codes: 0 ok, 2 bad input (scene, mesh, command line), 3 diverged, 4 results could not be
+// saved (a failed write), 1 internal error.
 // Every `run` writes <out>/summary.json (also on errors), <out>/scene.yaml and <out>/steps.csv.
 #include "coupling/Simulation.hpp"
 #include "core/MpiStart.hpp"
@@ -129,6 +130,8 @@ int commandRun(const std::string& sceneArg, const std::vector<std::string>& sets
     {
       std::ofstream s(out + "/scene.yaml");
       s << resolved;
+      s.flush();
+      if (!s) throw mfsi::OutputError("cannot write '" + out + "/scene.yaml'");
     }
     const auto result = sim->run(out, rank == 0 && mfsi::stdoutIsTerminal());
     summary.steps = result.steps;
@@ -144,6 +147,11 @@ int commandRun(const std::string& sceneArg, const std::vector<std::string>& sets
     summary.error = e.what();
     std::cerr << "diverged: " << e.what() << "\n";
     code = 3;
+  } catch (const mfsi::OutputError& e) {
+    summary.status = "error";
+    summary.error = std::string("output: ") + e.what();
+    std::cerr << "error: results not saved: " << e.what() << "\n";
+    code = 4;
   } catch (const std::exception& e) {
     summary.status = "error";
     summary.error = std::string("internal error: ") + e.what();

@@ -48,6 +48,13 @@ class DivergenceError : public std::runtime_error {
   using std::runtime_error::runtime_error;
 };
 
+/// \brief A result could not be saved (a failed write, a full disk, an unreadable results file): the
+/// run stops rather than report work it could not keep.
+class OutputError : public std::runtime_error {
+ public:
+  using std::runtime_error::runtime_error;
+};
+
 namespace detail {
 [[noreturn]] void assertFail(const char* cond, const char* file, int line, const std::string& msg);
 }  // namespace detail

@@ -68,6 +68,18 @@ double minScaledJacobian(const ExecSpace& exec, const HexMesh& mesh) {
   return jmin;
 }
 
+void cellScaledJacobians(const ExecSpace& exec, const HexMesh& mesh, const RealView& out) {
+  ConstReal3View pts = mesh.points();
+  ConstHex8View cn = mesh.cellNodes();
+  Kokkos::parallel_for(
+      "mfsi::core::quality::cellScaledJacobians", RangePolicy(exec, 0, mesh.nCells()), KOKKOS_LAMBDA(lid_t c) {
+        double x[8][3];
+        for (int a = 0; a < 8; ++a)
+          for (int k = 0; k < 3; ++k) x[a][k] = pts(cn(c, a), k);
+        out(c) = geom::hexMinScaledJacobian(x);
+      });
+}
+
 MeshQuality computeQuality(const ExecSpace& exec, const HexMesh& mesh, const MeshGeometry& geo) {
   ScopedRegion region("mfsi::core::quality");
   ConstRealView vol = geo.cellVolume;

@@ -39,4 +39,8 @@ MeshQuality computeQuality(const ExecSpace& exec, const HexMesh& mesh, const Mes
 /// one reduction; fences). The same value as `computeQuality(...).minScaledJacobian`.
 double minScaledJacobian(const ExecSpace& exec, const HexMesh& mesh);
 
+/// The minimum scaled Jacobian of each cell over its corners at the current points, into `out`
+/// (nCells; for output and for finding the worst cells; no fence).
+void cellScaledJacobians(const ExecSpace& exec, const HexMesh& mesh, const RealView& out);
+
 }  // namespace mfsi

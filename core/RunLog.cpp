@@ -77,17 +77,27 @@ void writeSummary(const std::string& dir, const RunSummary& s) {
   const std::string tmp = path + ".tmp";
   {
     std::ofstream out(tmp);
-    MFSI_CHECK(out, "cannot write " << tmp);
     out << toJson(s);
+    out.flush();
+    if (!out) {
+      out.close();
+      std::error_code ec;
+      std::filesystem::remove(tmp, ec);
+      throw OutputError("cannot write '" + tmp + "' (is the disk full?)");
+    }
   }
-  std::filesystem::rename(tmp, path);
+  std::error_code ec;
+  std::filesystem::rename(tmp, path, ec);
+  if (ec) throw OutputError("cannot rename '" + tmp + "' to '" + path + "': " + ec.message());
 }
 
 StepLog::StepLog(const std::string& path, std::vector<std::string> columns)
-    : out_(path), nColumns_(columns.size()) {
-  MFSI_CHECK(out_, "cannot write " << path);
+    : path_(path), out_(path), nColumns_(columns.size()) {
+  if (!out_) throw OutputError("cannot write '" + path + "'");
   for (std::size_t i = 0; i < columns.size(); ++i) out_ << (i ? "," : "") << columns[i];
   out_ << "\n";
+  out_.flush();
+  if (!out_) throw OutputError("cannot write '" + path + "' (is the disk full?)");
 }
 
 void StepLog::row(const std::vector<double>& values) {
@@ -95,6 +105,8 @@ void StepLog::row(const std::vector<double>& values) {
   out_ << std::setprecision(12);
   for (std::size_t i = 0; i < values.size(); ++i) out_ << (i ? "," : "") << values[i];
   out_ << "\n";
+  out_.flush();
+  if (!out_) throw OutputError("cannot write '" + path_ + "' (is the disk full?)");
 }
 
 bool stdoutIsTerminal() { return ::isatty(STDOUT_FILENO) == 1; }

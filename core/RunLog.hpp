@@ -43,10 +43,13 @@ class StepLog {
  public:
   StepLog() = default;
   StepLog(const std::string& path, std::vector<std::string> columns);
+  /// Append a row and flush it (a stopped run keeps every step it finished). Throws OutputError
+  /// when the write fails.
   void row(const std::vector<double>& values);
   bool isOpen() const { return out_.is_open(); }
 
  private:
+  std::string path_;
   std::ofstream out_;
   std::size_t nColumns_ = 0;
 };

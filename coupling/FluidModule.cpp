@@ -2,6 +2,7 @@
 
 #include "fluid/GhiaTable.hpp"
 #include "fluid/Loads.hpp"
+#include "core/io/HostCopy.hpp"
 
 #include <cmath>
 
@@ -97,6 +98,14 @@ void FluidModule::appendStepValues(std::vector<double>& v) const {
   if (reports_.probes.empty()) return;
   const std::vector<double> p = probePressures();
   v.insert(v.end(), p.begin(), p.end());
+}
+
+void FluidModule::addOutputFields(io::FieldFrame& frame) {
+  io::OutputGrid* grid = frame.find("mesh");
+  if (!grid) return;
+  const std::size_t n = static_cast<std::size_t>(solver_.mesh().nCells());
+  grid->addCellField("U", 3, io::hostValues(solver_.velocity(), n));
+  grid->addCellField("p", 1, io::hostValues(solver_.pressure(), n));
 }
 
 void FluidModule::addMetrics(std::map<std::string, double>& m) const {

@@ -25,6 +25,8 @@ class FluidModule final : public Module {
   /// fluid.* numbers: continuity, iteration totals, last residuals, forces, pressure differences,
   /// Ghia errors.
   void addMetrics(std::map<std::string, double>& metrics) const override;
+  /// U and p as cell fields of the scene mesh's grid.
+  void addOutputFields(io::FieldFrame& frame) override;
   std::vector<std::string> stepColumns() const override;
   void appendStepValues(std::vector<double>& values) const override;
 

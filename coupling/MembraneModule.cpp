@@ -1,5 +1,7 @@
 #include "coupling/MembraneModule.hpp"
 
+#include "core/io/HostCopy.hpp"
+
 #include <cmath>
 
 namespace mfsi {
@@ -108,6 +110,30 @@ void MembraneModule::appendStepValues(std::vector<double>& values) const {
   values.push_back(maxU_);
   values.push_back(centreW_);
   values.insert(values.end(), {centreU_[0], centreU_[1], centreU_[2]});
+}
+
+void MembraneModule::addOutputFields(io::FieldFrame& frame) {
+  const MembraneMesh& mesh = solver_->mesh();
+  const std::size_t nNodes = static_cast<std::size_t>(mesh.nNodes());
+  const std::size_t nElements = static_cast<std::size_t>(mesh.nElements());
+  io::OutputGrid g;
+  g.name = name();
+  g.shape = io::CellShape::Surface;
+  const std::vector<double> u = io::hostValues(solver_->displacement(), 3 * nNodes);
+  for (std::size_t i = 0; i < nNodes; ++i)
+    for (int k = 0; k < 3; ++k) g.points.push_back(mesh.hostPoints()[i][k] + u[3 * i + k]);
+  for (const auto& e : mesh.hostElements())
+    for (int a = 0; a < 4; ++a) g.cells.push_back(e[a]);
+  g.addPointField("displacement", 3, u);
+  g.addPointField("velocity", 3, io::hostValues(solver_->velocity(), 3 * nNodes));
+  const MembraneResults r = solver_->results();
+  g.addCellField("strain", 3, io::hostValues(r.elements.strain, nElements), false);
+  g.addCellField("stress", 3, io::hostValues(r.elements.stress, nElements), false);
+  g.addCellField("principalStress1", 1, io::hostValues(r.elements.principal1, nElements));
+  g.addCellField("principalStress2", 1, io::hostValues(r.elements.principal2, nElements));
+  g.addCellField("vonMises", 1, io::hostValues(r.elements.vonMises, nElements));
+  g.addCellField("wrinkleState", 1, io::hostValues(r.elements.wrinkleState, nElements));
+  frame.grids.push_back(std::move(g));
 }
 
 void MembraneModule::addMetrics(std::map<std::string, double>& metrics) const {

@@ -25,6 +25,11 @@ class MembraneModule final : public Module {
   /// "<name>.<summary key>" for every entry of MembraneSolver::summary(), and the comparison with
   /// the reference solution: hencky_w0 and hencky_rel_err, or period, period_exact and period_rel_err.
   void addMetrics(std::map<std::string, double>& metrics) const override;
+  /// A grid of its own: the deformed surface (reference + displacement), displacement and velocity
+  /// per node; per element the in-plane Green-Lagrange strain and PK2 stress (E11, E22, E12 and
+  /// S11, S22, S12 in the element basis), principal stresses, von Mises and the wrinkling state
+  /// (0 taut, 1 wrinkled, 2 slack).
+  void addOutputFields(io::FieldFrame& frame) override;
   /// Solves the t = 0 equilibrium of a static panel (the run is starting).
   void openOutput(const std::string& dir) override;
   std::vector<std::string> stepColumns() const override;

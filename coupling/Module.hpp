@@ -11,6 +11,7 @@
 #include "core/MeshGeometry.hpp"
 #include "core/SceneConfig.hpp"
 #include "core/Timers.hpp"
+#include "core/io/FieldOutput.hpp"
 
 #include <functional>
 #include <map>
@@ -43,6 +44,9 @@ class Module {
   virtual void addMetrics(std::map<std::string, double>& /*metrics*/) const {}
   /// Open the module's own output files in the run's output folder (before the first step).
   virtual void openOutput(const std::string& /*dir*/) {}
+  /// Add this module's fields to an output frame: a grid of its own (a membrane, the bodies) or
+  /// fields on another's (the fluid's U and p on the scene mesh's grid "mesh").
+  virtual void addOutputFields(io::FieldFrame& /*frame*/) {}
   /// Column names and values of this module in steps.csv.
   virtual std::vector<std::string> stepColumns() const { return {}; }
   virtual void appendStepValues(std::vector<double>& /*values*/) const {}

@@ -22,6 +22,29 @@ void RigidModule::recordStep() {
   if (csv_.is_open()) system_.writeCsvRows(csv_);
 }
 
+void RigidModule::addOutputFields(io::FieldFrame& frame) {
+  io::OutputGrid g;
+  g.name = "bodies";
+  g.shape = io::CellShape::Point;
+  std::vector<double> velocity, angularVelocity, euler, force, moment;
+  auto add = [](std::vector<double>& to, const Eigen::Vector3d& v) { to.insert(to.end(), {v.x(), v.y(), v.z()}); };
+  for (int b = 0; b < system_.nBodies(); ++b) {
+    const RigidBodyReport r = system_.bodyReport(b);
+    add(g.points, r.position);
+    add(velocity, r.velocity);
+    add(angularVelocity, r.angularVelocity);
+    add(euler, r.eulerAngles);
+    add(force, r.force);
+    add(moment, r.moment);
+  }
+  g.addPointField("velocity", 3, velocity);
+  g.addPointField("angularVelocity", 3, angularVelocity);
+  g.addPointField("rollPitchYaw", 3, euler, false);
+  g.addPointField("force", 3, force);
+  g.addPointField("moment", 3, moment);
+  frame.grids.push_back(std::move(g));
+}
+
 void RigidModule::addMetrics(std::map<std::string, double>& metrics) const {
   for (const auto& [k, v] : system_.metrics()) metrics["bodies." + k] = v;
   metrics["bodies.maxEnergyDrift"] = maxEnergyDrift_;

@@ -13,6 +13,9 @@ class RigidModule final : public Module {
   explicit RigidModule(const RigidSystemOptions& options);
   void advance(const TimeState& t) override;
   void addMetrics(std::map<std::string, double>& metrics) const override;
+  /// The grid "bodies": one point per body at its centre of mass, with its velocity, angular
+  /// velocity, (roll, pitch, yaw), force and moment.
+  void addOutputFields(io::FieldFrame& frame) override;
   void openOutput(const std::string& dir) override;
   std::vector<std::string> stepColumns() const override;
   void appendStepValues(std::vector<double>& values) const override;

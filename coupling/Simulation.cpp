@@ -1,6 +1,7 @@
 #include "coupling/Simulation.hpp"
 
 #include "core/MeshConfig.hpp"
+#include "core/io/HostCopy.hpp"
 
 #include <cmath>
 
@@ -15,6 +16,19 @@ Schema sceneSchema() {
                        .key("endTime", Schema::real("simulated end time (0: no stepping)", "s").atLeast(0), Default(0.0))
                        .key("dt", Schema::real("time step", "s").atLeast(0), Default(0.0))
                        .key("maxSteps", Schema::integer("stop after this many steps (0: no limit)").atLeast(0), Default(0)),
+           Presence::Optional)
+      .key("output",
+           Schema::map("results written during the run (summary.json and steps.csv are always written)")
+               .key("fields",
+                    Schema::map("fields for ParaView: one HDF5 file per frame in fields/, listed in fields.xdmf "
+                                "(open fields.xdmf)")
+                        .key("interval", Schema::real("a frame every this much simulated time (0: not by time)", "s")
+                                             .atLeast(0), Default(0.0))
+                        .key("everySteps", Schema::integer("a frame every this many steps (0: not by steps)").atLeast(0),
+                             Default(0))
+                        .key("initial", Schema::boolean("a frame of the state at the start"), Default(false))
+                        .key("final", Schema::boolean("a frame of the state at the end of the run"), Default(true)),
+                    Presence::Optional),
            Presence::Optional);
   for (const auto& entry : moduleCatalogue()) s.key(entry.section, entry.schema(), Presence::OptionalSection);
   return s;
@@ -32,6 +46,10 @@ Simulation::Simulation(const SceneConfig& scene) {
   time_.endTime = scene.get<double>("time.endTime");
   time_.dt = scene.get<double>("time.dt");
   time_.maxSteps = scene.get<int>("time.maxSteps");
+  fieldOutput_.interval = scene.get<double>("output.fields.interval");
+  fieldOutput_.everySteps = scene.get<int>("output.fields.everySteps");
+  fieldOutput_.initial = scene.get<bool>("output.fields.initial");
+  fieldOutput_.final = scene.get<bool>("output.fields.final");
   if (time_.endTime > 0 && time_.dt <= 0)
     throw InputError(scene.where("time.dt"), "a positive time step is needed when time.endTime > 0");
 
@@ -72,6 +90,31 @@ void Simulation::meshMetrics(std::map<std::string, double>& m) const {
   m["mesh.patches"] = static_cast<double>(mesh_.patches().size());
 }
 
+io::FieldFrame Simulation::fieldFrame(double time, long long step) {
+  io::FieldFrame frame;
+  frame.time = time;
+  frame.step = step;
+  if (hasMesh_) {
+    io::OutputGrid g;
+    g.name = "mesh";
+    g.shape = io::CellShape::Hexahedron;
+    const std::size_t nNodes = static_cast<std::size_t>(mesh_.nNodes());
+    const std::size_t nCells = static_cast<std::size_t>(mesh_.nCells());
+    g.points = io::hostValues(mesh_.points(), nNodes);
+    const std::vector<double> x0 = io::hostValues(mesh_.referencePoints(), nNodes);
+    std::vector<double> d(g.points.size());
+    for (std::size_t i = 0; i < d.size(); ++i) d[i] = g.points[i] - x0[i];
+    for (double c : io::hostValues(mesh_.cellNodes(), nCells)) g.cells.push_back(static_cast<std::int64_t>(c));
+    RealView quality("mfsi::output::scaledJacobian", nCells);
+    cellScaledJacobians(ExecSpace(), mesh_, quality);
+    g.addPointField("meshDisplacement", 3, std::move(d));
+    g.addCellField("scaledJacobian", 1, io::hostValues(quality, nCells));
+    frame.grids.push_back(std::move(g));
+  }
+  for (Module* m : reporting_) m->addOutputFields(frame);
+  return frame;
+}
+
 RunResult Simulation::run(const std::string& outDir, bool terminal) {
   RunResult r;
   long long nSteps = 0;
@@ -87,6 +130,15 @@ RunResult Simulation::run(const std::string& outDir, bool terminal) {
   Progress progress(nSteps, time_.endTime, terminal);
   TimeState ts;
   ts.endTime = time_.endTime;
+  io::FieldSeries fields(outDir);
+  long long lastFrameStep = -1;
+  auto writeFrame = [&] {
+    ScopedTimer t(timers_, "output");
+    fields.write(fieldFrame(ts.time, ts.step));
+    lastFrameStep = ts.step;
+  };
+  double nextFrameTime = fieldOutput_.interval;
+  if (fieldOutput_.initial) writeFrame();
   const double start = wallSeconds();
   for (long long s = 0; s < nSteps; ++s) {
     ts.dtOld = ts.step > 0 ? ts.dt : time_.dt;
@@ -102,14 +154,22 @@ RunResult Simulation::run(const std::string& outDir, bool terminal) {
     std::vector<double> row = {double(ts.step), ts.time, wallSeconds() - start};
     for (const Module* m : reporting_) m->appendStepValues(row);
     log.row(row);
+    bool frame = fieldOutput_.everySteps > 0 && ts.step % fieldOutput_.everySteps == 0;
+    if (fieldOutput_.interval > 0 && ts.time >= nextFrameTime - 1e-9 * ts.dt) {
+      frame = true;
+      while (nextFrameTime <= ts.time + 1e-9 * ts.dt) nextFrameTime += fieldOutput_.interval;
+    }
+    if (frame) writeFrame();
     progress.update(ts.step, ts.time);
   }
+  if (fieldOutput_.final && lastFrameStep != ts.step) writeFrame();
   progress.finish();
   r.steps = ts.step;
   r.simTime = ts.time;
   {
     ScopedTimer t(timers_, "metrics");
     meshMetrics(r.metrics);
+    r.metrics["output.field_frames"] = fields.frames();
     for (const Module* m : reporting_) m->addMetrics(r.metrics);
   }
   return r;

@@ -16,6 +16,14 @@ struct TimeOptions {
   int maxSteps = 0;  ///< 0: as many as endTime/dt needs
 };
 
+/// \brief When fields are written (`output.fields`).
+struct FieldOutputOptions {
+  real interval = 0.0;  ///< simulated time between frames (0: not by time)
+  int everySteps = 0;   ///< steps between frames (0: not by steps)
+  bool initial = false;  ///< a frame of the start state
+  bool final = true;     ///< a frame of the end state
+};
+
 /// \brief What `Simulation::run` reports back.
 struct RunResult {
   long long steps = 0;
@@ -44,12 +52,16 @@ class Simulation {
 
  private:
   void meshMetrics(std::map<std::string, double>& m) const;
+  /// The state now, as one output frame: the scene mesh's grid "mesh" (positions, displacement
+  /// from the reference mesh, each cell's scaled Jacobian) and every module's fields.
+  io::FieldFrame fieldFrame(double time, long long step);
 
   Timers timers_;
   bool hasMesh_ = false;
   HexMesh mesh_;
   MeshGeometry geometry_;
   TimeOptions time_;
+  FieldOutputOptions fieldOutput_;
   std::vector<std::unique_ptr<Module>> modules_;  ///< advanced by the driver
   std::vector<Module*> reporting_;                ///< modules_ and their parts: output, columns, metrics
   long long completedSteps_ = 0;

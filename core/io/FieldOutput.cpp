@@ -1,0 +1,249 @@
+#include "core/io/FieldOutput.hpp"
+
+#include "core/Error.hpp"
+#include "core/io/Hdf5File.hpp"
+
+#include <algorithm>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <iomanip>
+#include <sstream>
+#include <stdexcept>
+#include <system_error>
+
+namespace mfsi::io {
+
+namespace fs = std::filesystem;
+
+std::size_t OutputGrid::nCells() const {
+  switch (shape) {
+    case CellShape::Hexahedron: return cells.size() / 8;
+    case CellShape::Surface: return cells.size() / 4;
+    case CellShape::Point: return nPoints();
+  }
+  return 0;
+}
+
+namespace {
+
+void checkSize(const OutputGrid& g, const std::string& field, int components, std::size_t n, std::size_t size) {
+  if (components < 1 || size != n * static_cast<std::size_t>(components))
+    throw std::logic_error("output field '" + field + "' of grid '" + g.name + "' has " + std::to_string(size) +
+                           " values for " + std::to_string(n) + " x " + std::to_string(components));
+}
+
+/// XDMF's topology of a grid: its type, the dataset's values (the HDF5 layout XDMF reads) and shape.
+struct Topology {
+  std::string type;
+  std::vector<std::int64_t> values;
+  std::vector<std::size_t> dims;
+  int nodesPerElement = 0;
+};
+
+Topology topologyOf(const OutputGrid& g) {
+  Topology t;
+  const std::size_t n = g.nCells();
+  if (g.shape == CellShape::Hexahedron) {
+    t.type = "Hexahedron";
+    t.values = g.cells;
+    t.dims = {n, 8};
+    return t;
+  }
+  if (g.shape == CellShape::Point) {
+    t.type = "Polyvertex";
+    t.nodesPerElement = 1;
+    for (std::size_t i = 0; i < n; ++i) t.values.push_back(static_cast<std::int64_t>(i));
+    t.dims = {n};
+    return t;
+  }
+  std::size_t triangles = 0;
+  for (std::size_t c = 0; c < n; ++c) triangles += g.cells[4 * c + 3] < 0 ? 1 : 0;
+  if (triangles == 0 || triangles == n) {
+    const int k = triangles == 0 ? 4 : 3;
+    t.type = triangles == 0 ? "Quadrilateral" : "Triangle";
+    for (std::size_t c = 0; c < n; ++c)
+      for (int a = 0; a < k; ++a) t.values.push_back(g.cells[4 * c + a]);
+    t.dims = {n, static_cast<std::size_t>(k)};
+    return t;
+  }
+  // XDMF's mixed list: each cell's type id (4 triangle, 5 quadrilateral) then its nodes.
+  t.type = "Mixed";
+  for (std::size_t c = 0; c < n; ++c) {
+    const bool tri = g.cells[4 * c + 3] < 0;
+    t.values.push_back(tri ? 4 : 5);
+    for (int a = 0; a < (tri ? 3 : 4); ++a) t.values.push_back(g.cells[4 * c + a]);
+  }
+  t.dims = {t.values.size()};
+  return t;
+}
+
+std::string attributeType(const OutputField& f) {
+  if (f.components == 1) return "Scalar";
+  if (f.components == 3 && f.vector) return "Vector";
+  return "Matrix";
+}
+
+/// A scalar field is one-dimensional (what XDMF's "n" reads), others n x components.
+std::vector<std::size_t> shapeOf(std::size_t n, const OutputField& f) {
+  if (f.components == 1) return {n};
+  return {n, static_cast<std::size_t>(f.components)};
+}
+
+/// Text safe inside an XML attribute or element.
+std::string xml(const std::string& s) {
+  std::string o;
+  for (char c : s) {
+    switch (c) {
+      case '&': o += "&amp;"; break;
+      case '<': o += "&lt;"; break;
+      case '>': o += "&gt;"; break;
+      case '"': o += "&quot;"; break;
+      default: o += c;
+    }
+  }
+  return o;
+}
+
+std::string number(double v) {
+  std::ostringstream os;
+  os << std::setprecision(17) << v;
+  return os.str();
+}
+
+/// Write `text` to `path` through a temporary file and a rename; OutputError on any failure.
+void writeAtomically(const std::string& path, const std::string& text) {
+  const std::string tmp = path + ".part";
+  {
+    std::ofstream out(tmp, std::ios::binary | std::ios::trunc);
+    out << text;
+    out.flush();
+    if (!out) {
+      out.close();
+      std::error_code ec;
+      fs::remove(tmp, ec);
+      throw OutputError("cannot write '" + tmp + "' (is the disk full?)");
+    }
+  }
+  std::error_code ec;
+  fs::rename(tmp, path, ec);
+  if (ec) throw OutputError("cannot rename '" + tmp + "' to '" + path + "': " + ec.message());
+}
+
+}  // namespace
+
+void OutputGrid::addPointField(std::string fieldName, int components, std::vector<double> values, bool vector) {
+  checkSize(*this, fieldName, components, nPoints(), values.size());
+  pointFields.push_back({std::move(fieldName), components, std::move(values), vector});
+}
+
+void OutputGrid::addCellField(std::string fieldName, int components, std::vector<double> values, bool vector) {
+  checkSize(*this, fieldName, components, nCells(), values.size());
+  cellFields.push_back({std::move(fieldName), components, std::move(values), vector});
+}
+
+OutputGrid* FieldFrame::find(const std::string& name) {
+  for (auto& g : grids)
+    if (g.name == name) return &g;
+  return nullptr;
+}
+
+FieldSeries::FieldSeries(std::string runDir) : dir_(std::move(runDir)), indexPath_(dir_ + "/fields.xdmf") {}
+
+std::string FieldSeries::framePath(int i) const { return dir_ + "/" + entries_.at(static_cast<std::size_t>(i)).file; }
+
+void FieldSeries::write(const FieldFrame& frame) {
+  std::error_code ec;
+  fs::create_directories(dir_ + "/fields", ec);
+  if (ec) throw OutputError("cannot create '" + dir_ + "/fields': " + ec.message());
+  char name[64];
+  std::snprintf(name, sizeof name, "fields/fields_%06lld.h5", frame.step);
+  Entry entry{frame.time, name, {}};
+
+  Hdf5File h5 = Hdf5File::create(dir_ + "/" + entry.file);
+  h5.writeAttribute("time", frame.time);
+  h5.writeAttribute("step", static_cast<double>(frame.step));
+  for (const OutputGrid& g : frame.grids) {
+    const Topology topo = topologyOf(g);
+    const std::string root = "/" + g.name;
+    h5.write(root + "/points", g.points, {g.nPoints(), 3});
+    h5.write(root + "/topology", topo.values, topo.dims);
+    GridEntry ge{g.name, g.shape, g.nPoints(), g.nCells(), topo.values.size(), {}, {}};
+    for (const auto& f : g.pointFields) {
+      h5.write(root + "/point/" + f.name, f.values, shapeOf(g.nPoints(), f));
+      ge.pointFields.push_back({f.name, f.components, {}, f.vector});
+    }
+    for (const auto& f : g.cellFields) {
+      h5.write(root + "/cell/" + f.name, f.values, shapeOf(g.nCells(), f));
+      ge.cellFields.push_back({f.name, f.components, {}, f.vector});
+    }
+    entry.grids.push_back(std::move(ge));
+  }
+  h5.commit();
+  entries_.push_back(std::move(entry));
+  writeAtomically(indexPath_, xdmf());
+}
+
+std::string FieldSeries::xdmf() const {
+  // One temporal collection per grid name (ParaView shows each as a block of one dataset).
+  std::vector<std::string> names;
+  for (const auto& e : entries_)
+    for (const auto& g : e.grids)
+      if (std::find(names.begin(), names.end(), g.name) == names.end()) names.push_back(g.name);
+
+  std::ostringstream x;
+  x << "<?xml version=\"1.0\" ?>\n<Xdmf Version=\"3.0\">\n  <Domain>\n";
+  for (const auto& gridName : names) {
+    x << "    <Grid Name=\"" << xml(gridName) << "\" GridType=\"Collection\" CollectionType=\"Temporal\">\n";
+    for (const auto& e : entries_) {
+      for (const auto& g : e.grids) {
+        if (g.name != gridName) continue;
+        const std::string h5 = e.file + ":/" + g.name;
+        auto item = [&](const std::string& path, const std::string& dims, const char* type) {
+          return "<DataItem Dimensions=\"" + dims + "\" NumberType=\"" + type + "\" Precision=\"8\" Format=\"HDF\">" +
+                 xml(h5 + path) + "</DataItem>";
+        };
+        std::string type, topoDims = std::to_string(g.topologySize);
+        switch (g.shape) {
+          case CellShape::Hexahedron: type = "Hexahedron"; topoDims = std::to_string(g.nCells) + " 8"; break;
+          case CellShape::Point: type = "Polyvertex"; break;
+          case CellShape::Surface:
+            if (g.topologySize == 4 * g.nCells) {
+              type = "Quadrilateral";
+              topoDims = std::to_string(g.nCells) + " 4";
+            } else if (g.topologySize == 3 * g.nCells) {
+              type = "Triangle";
+              topoDims = std::to_string(g.nCells) + " 3";
+            } else {
+              type = "Mixed";
+            }
+            break;
+        }
+        x << "      <Grid Name=\"" << xml(g.name) << "\" GridType=\"Uniform\">\n"
+          << "        <Time Value=\"" << number(e.time) << "\"/>\n"
+          << "        <Topology TopologyType=\"" << type << "\" NumberOfElements=\"" << g.nCells << "\""
+          << (g.shape == CellShape::Point ? " NodesPerElement=\"1\"" : "") << ">\n"
+          << "          " << item("/topology", topoDims, "Int") << "\n        </Topology>\n"
+          << "        <Geometry GeometryType=\"XYZ\">\n"
+          << "          " << item("/points", std::to_string(g.nPoints) + " 3", "Float") << "\n        </Geometry>\n";
+        auto attributes = [&](const std::vector<OutputField>& fields, const char* center, const char* group,
+                              std::size_t n) {
+          for (const auto& f : fields) {
+            const std::string dims = std::to_string(n) + (f.components > 1 ? " " + std::to_string(f.components) : "");
+            x << "        <Attribute Name=\"" << xml(f.name) << "\" AttributeType=\"" << attributeType(f) << "\" Center=\""
+              << center << "\">\n          " << item(std::string("/") + group + "/" + f.name, dims, "Float")
+              << "\n        </Attribute>\n";
+          }
+        };
+        attributes(g.pointFields, "Node", "point", g.nPoints);
+        attributes(g.cellFields, "Cell", "cell", g.nCells);
+        x << "      </Grid>\n";
+      }
+    }
+    x << "    </Grid>\n";
+  }
+  x << "  </Domain>\n</Xdmf>\n";
+  return x.str();
+}
+
+}  // namespace mfsi::io

@@ -1,0 +1,90 @@
+#pragma once
+/// \file
+/// \brief Field output for ParaView: each output time is one HDF5 file (`fields/fields_<step>.h5`)
+/// holding every grid of the run (the fluid mesh, each membrane, the rigid bodies), and one XDMF
+/// file (`fields.xdmf`) lists them as time series, so ParaView opens the whole run as one dataset.
+///
+/// The modules fill a FieldFrame on the host (positions, cells and fields as plain arrays); the
+/// series writes it. Both files of an output time are written under temporary names and renamed,
+/// so an interrupted run leaves the frames it finished and an XDMF file that lists exactly those.
+#include <cstdint>
+#include <string>
+#include <vector>
+
+namespace mfsi::io {
+
+/// \brief One field on a grid: `components` values per point or per cell, point or cell major.
+/// Three components are a vector (ParaView draws glyphs of it) unless `vector` is false (e.g. the
+/// in-plane strain E11, E22, E12).
+struct OutputField {
+  std::string name;
+  int components = 1;
+  std::vector<double> values;
+  bool vector = true;
+};
+
+/// How a grid's cells are given.
+enum class CellShape {
+  Hexahedron,  ///< 8 nodes per cell, VTK order
+  Surface,     ///< 4 nodes per cell; a triangle has -1 in its fourth slot
+  Point        ///< one vertex per point (rigid bodies, probes): no cell list
+};
+
+/// \brief A grid of one output time: positions (3 per point), cells, point and cell fields.
+struct OutputGrid {
+  std::string name;
+  CellShape shape = CellShape::Point;
+  std::vector<double> points;
+  std::vector<std::int64_t> cells;
+  std::vector<OutputField> pointFields;
+  std::vector<OutputField> cellFields;
+
+  std::size_t nPoints() const { return points.size() / 3; }
+  std::size_t nCells() const;
+  /// Add a field; throws std::logic_error when its size does not match the grid.
+  void addPointField(std::string fieldName, int components, std::vector<double> values, bool vector = true);
+  void addCellField(std::string fieldName, int components, std::vector<double> values, bool vector = true);
+};
+
+/// \brief Everything written at one output time.
+struct FieldFrame {
+  double time = 0;
+  long long step = 0;
+  std::vector<OutputGrid> grids;
+  /// The grid of that name, or null.
+  OutputGrid* find(const std::string& name);
+};
+
+/// \brief The time series of a run: writes frames and keeps the XDMF index in step with them.
+class FieldSeries {
+ public:
+  /// Frames go to `<runDir>/fields/`, the index to `<runDir>/fields.xdmf`.
+  explicit FieldSeries(std::string runDir);
+  /// Write one frame and rewrite the index. Throws OutputError when anything cannot be written
+  /// (the frames written before stay listed and readable).
+  void write(const FieldFrame& frame);
+  int frames() const { return static_cast<int>(entries_.size()); }
+  const std::string& indexPath() const { return indexPath_; }
+  /// The HDF5 file of frame `i` (0-based, in writing order).
+  std::string framePath(int i) const;
+
+ private:
+  struct GridEntry {
+    std::string name;
+    CellShape shape;
+    std::size_t nPoints, nCells, topologySize;
+    std::vector<OutputField> pointFields, cellFields;  ///< names and components (no values)
+  };
+  struct Entry {
+    double time;
+    std::string file;  ///< relative to the run folder
+    std::vector<GridEntry> grids;
+  };
+  std::string xdmf() const;
+
+  std::string dir_;
+  std::string indexPath_;
+  std::vector<Entry> entries_;
+};
+
+}  // namespace mfsi::io

@@ -1,0 +1,59 @@
+#pragma once
+/// \file
+/// \brief One HDF5 file of results: datasets of doubles or 64-bit integers at slash paths
+/// ("/mesh/points"), written whole, every call checked.
+///
+/// A file being written lives under a temporary name (`<path>.part`) and appears at its own path
+/// only on `commit()`, so a crash, a signal or a full disk never leaves a truncated file that looks
+/// complete. Serial HDF5 calls on the library of Debian's Open MPI build; a distributed run will add
+/// per-rank hyperslabs of the same datasets.
+#include <cstdint>
+#include <string>
+#include <vector>
+
+namespace mfsi::io {
+
+class Hdf5File {
+ public:
+  /// Start a new file that will appear at `path` on commit (an existing file there stays until
+  /// then). Throws OutputError naming the path when the file cannot be created.
+  static Hdf5File create(const std::string& path);
+  /// Open an existing file for reading. Throws OutputError naming the path.
+  static Hdf5File openRead(const std::string& path);
+
+  Hdf5File(Hdf5File&& other) noexcept;
+  Hdf5File& operator=(Hdf5File&& other) noexcept;
+  Hdf5File(const Hdf5File&) = delete;
+  Hdf5File& operator=(const Hdf5File&) = delete;
+  /// Closes the file; a created file that was not committed is removed.
+  ~Hdf5File();
+
+  /// Write a dataset of `dims` (row-major; the product must equal the data's size); the groups on
+  /// its path are created as needed. Throws OutputError naming file and dataset.
+  void write(const std::string& dataset, const std::vector<double>& data, const std::vector<std::size_t>& dims);
+  void write(const std::string& dataset, const std::vector<std::int64_t>& data, const std::vector<std::size_t>& dims);
+  /// A scalar attribute on the root group.
+  void writeAttribute(const std::string& name, double value);
+
+  /// Read a whole dataset; `dims` (optional) receives its shape. Throws OutputError when absent.
+  std::vector<double> readDoubles(const std::string& dataset, std::vector<std::size_t>* dims = nullptr) const;
+  std::vector<std::int64_t> readInts(const std::string& dataset, std::vector<std::size_t>* dims = nullptr) const;
+  double readAttribute(const std::string& name) const;
+  bool has(const std::string& dataset) const;
+
+  /// Flush and close the file, then rename it to its path. Throws OutputError when any of it fails.
+  void commit();
+
+  const std::string& path() const { return path_; }
+
+ private:
+  Hdf5File() = default;
+  void close() noexcept;
+  std::int64_t openDataset(const std::string& dataset, std::vector<std::size_t>* dims) const;
+
+  std::int64_t file_ = -1;  ///< hid_t
+  std::string path_;        ///< where the file appears
+  std::string writing_;     ///< the temporary name while it is written ("" when reading)
+};
+
+}  // namespace mfsi::io
