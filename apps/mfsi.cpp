@@ -12,7 +12,6 @@
 // saved (a failed write), 1 internal error.
 // Every `run` writes <out>/summary.json (also on errors), <out>/scene.yaml and <out>/steps.csv.
 #include "coupling/Simulation.hpp"
-#include "core/MpiStart.hpp"
 #include "core/RunLog.hpp"
 
 #include <CLI/CLI.hpp>
@@ -204,7 +203,7 @@ int main(int argc, char** argv) {
 
   CLI11_PARSE(app, argc, argv);
 
-  mfsi::mpiInit(&argc, &argv);
+  MPI_Init(&argc, &argv);
   int code = 0;
   {
     // Kokkos options are passed as arguments: the spelling of the thread-count flag changed in 4.x.

@@ -111,7 +111,12 @@ io::FieldFrame Simulation::fieldFrame(double time, long long step) {
     g.addCellField("scaledJacobian", 1, io::hostValues(quality, nCells));
     frame.grids.push_back(std::move(g));
   }
-  for (Module* m : reporting_) m->addOutputFields(frame);
+  // Parts first, then the module that owns them (the coupling moves a mounted membrane's grid to
+  // where its frames carry it).
+  for (auto& m : modules_) {
+    for (Module* p : m->parts()) p->addOutputFields(frame);
+    m->addOutputFields(frame);
+  }
   return frame;
 }
 

@@ -1,5 +1,7 @@
 #include "coupling/orchestrator/FsiCoupling.hpp"
 
+#include "core/io/HostCopy.hpp"
+
 #include "core/Error.hpp"
 #include "core/Suggest.hpp"
 #include "fluid/BoundaryConditions.hpp"
@@ -205,6 +207,18 @@ void FsiCoupling::setUpParents(const SceneConfig& section) {
     p.parents = coupling::ParentFrames(p.module->solver().mesh().hostPoints(), candidates, candidateBody,
                                        static_cast<int>(bodies_.size()));
     p.mounted = true;
+  }
+}
+
+void FsiCoupling::addOutputFields(io::FieldFrame& frame) {
+  std::vector<double> points;
+  for (const Panel& p : panels_) {
+    io::OutputGrid* grid = p.mounted ? frame.find(p.module->name()) : nullptr;
+    if (!grid) continue;
+    if (points.empty()) points = io::hostValues(mesh_.points(), static_cast<std::size_t>(mesh_.nNodes()));
+    const std::vector<double> node = io::hostValues(p.iface.fluidNode, static_cast<std::size_t>(p.iface.nNodes()));
+    for (std::size_t i = 0; i < node.size(); ++i)
+      for (std::size_t k = 0; k < 3; ++k) grid->points[3 * i + k] = points[3 * static_cast<std::size_t>(node[i]) + k];
   }
 }
 

@@ -57,6 +57,9 @@ class FsiCoupling final : public Module {
   std::vector<std::string> stepColumns() const override;
   void appendStepValues(std::vector<double>& values) const override;
   std::vector<Module*> parts() override;
+  /// A mounted membrane's grid (its module wrote it: reference + relative displacement) moved to
+  /// where the membrane is: the fluid nodes it carries (its `displacement` stays frame-relative).
+  void addOutputFields(io::FieldFrame& frame) override;
 
   FluidModule& fluid() { return *fluid_; }
   MembraneModule& membrane(std::size_t i) { return *panels_[i].module; }

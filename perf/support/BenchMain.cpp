@@ -1,7 +1,5 @@
 #include "support/BenchMain.hpp"
 
-#include "core/MpiStart.hpp"
-
 #include <mpi.h>
 
 #include <cstdlib>
@@ -22,7 +20,7 @@ void setRates(benchmark::State& state, double bytesPerIter, double itemsPerIter,
 }  // namespace mfsi::bench
 
 int main(int argc, char** argv) {
-  mfsi::mpiInit(&argc, &argv);
+  MPI_Init(&argc, &argv);
   {
     Kokkos::ScopeGuard kokkos(argc, argv);
     benchmark::AddCustomContext("kokkos_backend", Kokkos::DefaultExecutionSpace::name());
