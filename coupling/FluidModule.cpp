@@ -44,20 +44,24 @@ FluidModule::FluidModule(const HexMesh& mesh, const FluidOptions& options, Fluid
   // Nearest cell centroids, found once on the mesh as built.
   const std::size_t n = reports_.probes.size();
   probeCells_ = IndexView("mfsi::fluid::probes::cells", n);
-  probeValues_ = RealView("mfsi::fluid::probes::values", n);
+  probeValues_ = RealView("mfsi::fluid::probes::values", 4 * n);
   auto C = Kokkos::create_mirror_view_and_copy(HostSpace(), solver_.geometry().cellCentroid);
   auto h = Kokkos::create_mirror_view(probeCells_);
   for (std::size_t i = 0; i < n; ++i) h(i) = nearestCell(C, reports_.probes[i].point);
   Kokkos::deep_copy(probeCells_, h);
 }
 
-std::vector<double> FluidModule::probePressures() const {
+std::vector<double> FluidModule::probeValues() const {
   const IndexView cells = probeCells_;
   const RealView values = probeValues_;
   const ConstRealView p = solver_.pressure();
+  const ConstReal3View U = solver_.velocity();
   Kokkos::parallel_for(
       "mfsi::fluid::probes::gather", RangePolicy(ExecSpace(), 0, static_cast<lid_t>(cells.extent(0))),
-      KOKKOS_LAMBDA(lid_t i) { values(i) = p(cells(i)); });
+      KOKKOS_LAMBDA(lid_t i) {
+        values(4 * i) = p(cells(i));
+        for (int k = 0; k < 3; ++k) values(4 * i + 1 + k) = U(cells(i), k);
+      });
   auto h = Kokkos::create_mirror_view_and_copy(HostSpace(), values);
   return std::vector<double>(h.data(), h.data() + h.extent(0));
 }
@@ -87,7 +91,17 @@ std::vector<std::string> FluidModule::stepColumns() const {
   std::vector<std::string> columns = {"outerIterations",  "momentumIterations",   "pressureIterations",
                                       "continuityMax",    "momentumResidual",     "pressureResidual",
                                       "finalMomentumResidual", "finalPressureResidual"};
-  for (const auto& p : reports_.probes) columns.push_back("probe." + p.name);
+  for (const auto& p : reports_.probes)
+    for (const char* q : {"", ".Ux", ".Uy", ".Uz"}) columns.push_back("probe." + p.name + q);
+  for (const auto& f : reports_.forces) {
+    for (const char* q : {"force_x", "force_y", "force_z", "moment_x", "moment_y", "moment_z"})
+      columns.push_back(f.patch + "." + q);
+    if (f.referenceVelocity > 0) {
+      columns.push_back(f.patch + ".c_D");
+      columns.push_back(f.patch + ".c_L");
+    }
+  }
+  for (const auto& p : reports_.pressureDifferences) columns.push_back(p.name);
   return columns;
 }
 
@@ -95,9 +109,21 @@ void FluidModule::appendStepValues(std::vector<double>& v) const {
   v.insert(v.end(), {double(last_.outerIterations), double(last_.momentumIterations), double(last_.pressureIterations),
                      last_.continuityMax, last_.momentumResidual, last_.pressureResidual, last_.finalMomentumResidual,
                      last_.finalPressureResidual});
-  if (reports_.probes.empty()) return;
-  const std::vector<double> p = probePressures();
-  v.insert(v.end(), p.begin(), p.end());
+  if (!reports_.probes.empty()) {
+    const std::vector<double> p = probeValues();
+    v.insert(v.end(), p.begin(), p.end());
+  }
+  for (const auto& f : reports_.forces) {
+    const PatchLoads L = patchLoads(solver_, f.patch, f.point);
+    v.insert(v.end(), {L.force[0], L.force[1], L.force[2], L.moment[0], L.moment[1], L.moment[2]});
+    if (f.referenceVelocity > 0) {
+      const double q = 0.5 * solver_.options().density * f.referenceVelocity * f.referenceVelocity * f.referenceArea;
+      v.push_back(dot(L.force, f.dragDirection) / q);
+      v.push_back(dot(L.force, f.liftDirection) / q);
+    }
+  }
+  for (const auto& p : reports_.pressureDifferences)
+    v.push_back(pressureAt(solver_, p.from, p.patch) - pressureAt(solver_, p.to, p.patch));
 }
 
 void FluidModule::addOutputFields(io::FieldFrame& frame) {

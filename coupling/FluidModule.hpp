@@ -27,14 +27,16 @@ class FluidModule final : public Module {
   void addMetrics(std::map<std::string, double>& metrics) const override;
   /// U and p as cell fields of the scene mesh's grid.
   void addOutputFields(io::FieldFrame& frame) override;
+  /// Per step: iteration counts and residuals; each probe's p, Ux, Uy, Uz; each force report's
+  /// force and moment (and c_D, c_L with a reference velocity); each pressure difference.
   std::vector<std::string> stepColumns() const override;
   void appendStepValues(std::vector<double>& values) const override;
 
   fluid::FluidSolver& solver() { return solver_; }
   const fluid::StepResult& lastStep() const { return last_; }
 
-  /// The probes' cell pressures now (public for nvcc: it launches a kernel).
-  std::vector<double> probePressures() const;
+  /// The probes' cell values now: p, Ux, Uy, Uz per probe (public for nvcc: it launches a kernel).
+  std::vector<double> probeValues() const;
 
  private:
   void account(const TimeState& t);  ///< totals and the divergence check of a solve

@@ -241,14 +241,20 @@ Schema fluidSchema() {
                            "(wall -> wall, symmetry -> slip, empty -> empty, baffle -> wall moved by a membrane)",
                            boundarySchema()),
            Presence::Optional)
-      .key("forces", Schema::list("patches whose force and moment are reported", forceSchema()), Presence::Optional)
-      .key("pressureDifferences", Schema::list("pressure differences reported as metrics", pressureDifferenceSchema()),
+      .key("forces",
+           Schema::list("patches whose force and moment are reported: every step in steps.csv (fluid.<patch>.force_x "
+                        "... moment_z, c_D and c_L) and at the end in summary.json", forceSchema()),
+           Presence::Optional)
+      .key("pressureDifferences",
+           Schema::list("pressure differences reported every step in steps.csv (fluid.<name>) and at the end in "
+                        "summary.json", pressureDifferenceSchema()),
            Presence::Optional)
       .key("probes",
-           Schema::list("pressure probes written every step (steps.csv column fluid.probe.<name>): the cell "
+           Schema::list("probes written every step (steps.csv columns fluid.probe.<name> for p, and "
+                        "fluid.probe.<name>.Ux, .Uy, .Uz): the values of the cell "
                         "whose centroid is nearest to the point in the mesh as built (the cell moves with a moving "
                         "mesh)",
-                        Schema::map("a pressure probe")
+                        Schema::map("a probe")
                             .key("name", Schema::string("column name"))
                             .key("point", Schema::realVector(3, "point", "m"))),
            Presence::Optional)

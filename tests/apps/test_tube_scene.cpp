@@ -6,6 +6,8 @@
 #include "coupling/Module.hpp"
 #include "coupling/Simulation.hpp"
 
+#include "support/StepsCsv.hpp"
+
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -17,21 +19,6 @@
 #include <vector>
 
 namespace {
-
-/// steps.csv as columns.
-std::map<std::string, std::vector<double>> readSteps(const std::string& file) {
-  std::ifstream in(file);
-  std::string line, cell;
-  std::getline(in, line);
-  std::vector<std::string> names;
-  for (std::istringstream h(line); std::getline(h, cell, ',');) names.push_back(cell);
-  std::map<std::string, std::vector<double>> cols;
-  while (std::getline(in, line)) {
-    std::istringstream s(line);
-    for (std::size_t k = 0; k < names.size() && std::getline(s, cell, ','); ++k) cols[names[k]].push_back(std::stod(cell));
-  }
-  return cols;
-}
 
 /// First time the series rises through `level` (linear between steps), NAN if it never does.
 double crossing(const std::vector<double>& t, const std::vector<double>& v, double level) {
@@ -52,7 +39,7 @@ TEST(TubeScene, PulseTravelsAtTheMoensKortewegSpeed) {
     mfsi::Simulation sim(cfg);
     r = sim.run(dir, false);
   }
-  const auto steps = readSteps(dir + "/steps.csv");
+  const auto steps = mfsi::test::readSteps(dir + "/steps.csv");
   const double half = 0.5 * 1333.2;
   const double t10 = crossing(steps.at("time"), steps.at("fluid.probe.p_z10"), half);
   const double t30 = crossing(steps.at("time"), steps.at("fluid.probe.p_z30"), half);
