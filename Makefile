@@ -36,7 +36,7 @@ build: configure
 	@cmake --build $(BUILD_DIR) -j $(JOBS)
 
 run: build
-	@OMP_PROC_BIND=false ./$(BUILD_DIR)/apps/mfsi run $(SCENE) --out $(OUT)
+	@OMP_PROC_BIND=false ./$(BUILD_DIR)/apps/mfsi run $(SCENE) --out $(OUT) --overwrite
 
 test: build
 	@cd $(BUILD_DIR) && OMP_PROC_BIND=false ctest --output-on-failure -j $(JOBS) --timeout 900

@@ -1,7 +1,7 @@
 // mfsi — the membrane-fsi command.
 //
 //   mfsi run                                  # the default scene (membrane-channel), results in results/<scene>/
-//   mfsi run cases/box.yaml --out /tmp/box --threads 2
+//   mfsi run cases/box.yaml --out /tmp/box --threads 2 [--overwrite]
 //   mfsi run box --set mesh.blocks.0.cells=[32,32,8]
 //   mfsi check cases/box.yaml                 # validate without running (also builds the mesh)
 //   mfsi check --describe                     # every scene key with type, default, units, doc
@@ -10,7 +10,9 @@
 //
 // Exit codes: 0 ok, 2 bad input (scene, mesh, command line), 3 diverged, 4 results could not be
 // saved (a failed write), 1 internal error.
-// Every `run` writes <out>/summary.json (also on errors), <out>/scene.yaml and <out>/steps.csv.
+// Every `run` writes <out>/summary.json (also on errors), <out>/scene.yaml and <out>/steps.csv (and
+// fields.xdmf with fields/ as the scene's `output` asks); a folder that holds an earlier run's
+// results is refused (exit 2, nothing written) unless --overwrite.
 #include "coupling/Simulation.hpp"
 #include "core/RunLog.hpp"
 
@@ -97,7 +99,43 @@ int commandCheck(const std::string& scene, const std::vector<std::string>& sets,
   }
 }
 
-int commandRun(const std::string& sceneArg, const std::vector<std::string>& sets, std::string out) {
+/// What a run writes into its output folder (files, and the folder of field frames).
+const char* const kRunOutputs[] = {"summary.json", "scene.yaml", "steps.csv", "bodies.csv", "fields.xdmf", "fields"};
+
+/// Make `out` ready for a run before anything is built: a folder that holds another run's results
+/// is refused unless `overwrite` (which removes exactly those results, nothing else of the
+/// folder's), so a run never mixes its files with an earlier run's nor replaces its summary.
+/// Throws InputError (exit 2) with nothing written.
+void prepareOutput(const std::string& out, bool overwrite) {
+  std::error_code ec;
+  if (fs::exists(out, ec) && !fs::is_directory(out, ec))
+    throw mfsi::InputError("--out '" + out + "' is a file, not a folder");
+  std::vector<std::string> found;
+  for (const char* name : kRunOutputs)
+    if (fs::exists(fs::path(out) / name, ec)) found.push_back(name);
+  if (!found.empty() && !overwrite) {
+    std::string list;
+    for (const auto& f : found) list += (list.empty() ? "" : ", ") + f;
+    throw mfsi::InputError("--out '" + out + "' holds the results of an earlier run (" + list +
+                           "): give another --out, or --overwrite to replace them");
+  }
+  for (const auto& f : found) {
+    fs::remove_all(fs::path(out) / f, ec);
+    if (ec) throw mfsi::InputError("--overwrite: cannot remove '" + (fs::path(out) / f).string() + "': " + ec.message());
+  }
+  fs::create_directories(out, ec);
+  if (ec) throw mfsi::InputError("--out '" + out + "': cannot create the folder: " + ec.message());
+  const fs::path probe = fs::path(out) / ".mfsi-write-test";
+  {
+    std::ofstream test(probe);
+    test << "ok";
+    test.flush();
+    if (!test) throw mfsi::InputError("--out '" + out + "': the folder is not writable");
+  }
+  fs::remove(probe, ec);
+}
+
+int commandRun(const std::string& sceneArg, const std::vector<std::string>& sets, std::string out, bool overwrite) {
   const double t0 = mfsi::wallSeconds();
   mfsi::RunSummary summary;
   summary.scene = sceneArg;
@@ -109,6 +147,12 @@ int commandRun(const std::string& sceneArg, const std::vector<std::string>& sets
   int code = 0;
   std::unique_ptr<mfsi::Simulation> sim;
   if (out.empty()) out = (fs::path("results") / fs::path(sceneArg).stem()).string();
+  try {
+    if (rank == 0) prepareOutput(out, overwrite);
+  } catch (const mfsi::InputError& e) {
+    std::cerr << "error: " << e.what() << "\n";  // no summary: the folder is not ours to write
+    return 2;
+  }
   try {
     const fs::path file = resolveScene(sceneArg);
     const auto cfg = mfsi::SceneConfig::load(file.string(), mfsi::sceneSchema(), sets);
@@ -125,7 +169,6 @@ int commandRun(const std::string& sceneArg, const std::vector<std::string>& sets
       summary.cells = sim->mesh().nCells();
       summary.nodes = sim->mesh().nNodes();
     }
-    fs::create_directories(out);
     {
       std::ofstream s(out + "/scene.yaml");
       s << resolved;
@@ -187,11 +230,13 @@ int main(int argc, char** argv) {
   std::vector<std::string> sets;
   int threads = 0;
   bool describe = false;
+  bool overwrite = false;
 
   auto* run = app.add_subcommand("run", "run a scene (default: the built-in default scene)");
   run->add_option("scene", scene, "scene file, or the name of a built-in scene");
   run->add_option("--set", sets, "override a scene value: --set a.b.c=value (repeatable)");
   run->add_option("--out", out, "output folder (default: results/<scene>)");
+  run->add_flag("--overwrite", overwrite, "replace the results of an earlier run in the output folder");
   run->add_option("--threads", threads, "host threads (default: OMP_NUM_THREADS or all cores)")->check(CLI::PositiveNumber);
 
   auto* check = app.add_subcommand("check", "validate a scene without running it");
@@ -220,7 +265,7 @@ int main(int argc, char** argv) {
     int kargc = static_cast<int>(kargv.size());
     Kokkos::ScopeGuard kokkos(kargc, kargv.data());
     if (app.got_subcommand("run")) {
-      code = commandRun(scene, sets, out);
+      code = commandRun(scene, sets, out, overwrite);
     } else if (app.got_subcommand("check")) {
       code = commandCheck(scene, sets, describe);
     } else {
