@@ -33,7 +33,7 @@ APT_PACKAGES=(
   libeigen3-dev libhdf5-openmpi-dev libmetis-dev
   libgtest-dev libgmock-dev libbenchmark-dev
   libyaml-cpp-dev libcli11-dev
-  python3 python3-numpy python3-matplotlib python3-h5py
+  python3 python3-numpy python3-matplotlib python3-h5py python3-paraview
   dpkg-dev
 )
 
