@@ -246,7 +246,12 @@ int main(int argc, char** argv) {
 
   app.add_subcommand("scenes", "list the built-in scenes");
 
-  CLI11_PARSE(app, argc, argv);
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::ParseError& e) {
+    // --help and --version exit 0; a command-line error is bad input: exit 2 like any other.
+    return app.exit(e) == 0 ? 0 : 2;
+  }
 
   MPI_Init(&argc, &argv);
   int code = 0;

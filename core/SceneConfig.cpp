@@ -6,6 +6,7 @@
 
 #include <cerrno>
 #include <cstring>
+#include <filesystem>
 #include <fstream>
 #include <functional>
 #include <sstream>
@@ -187,6 +188,14 @@ SceneConfig SceneConfig::fromString(const std::string& yaml, const std::string& 
 
 SceneConfig SceneConfig::load(const std::string& file, const Schema& schema,
                               const std::vector<std::string>& overrides) {
+  // A scene is a regular file of modest size (a FIFO would block, /dev/zero never ends).
+  constexpr std::uintmax_t kMaxSceneBytes = 16u << 20;
+  std::error_code ec;
+  if (!std::filesystem::exists(file, ec)) throw InputError("cannot open scene file '" + file + "': no such file");
+  if (!std::filesystem::is_regular_file(file, ec))
+    throw InputError("cannot open scene file '" + file + "': not a regular file");
+  if (std::filesystem::file_size(file, ec) > kMaxSceneBytes)
+    throw InputError("cannot open scene file '" + file + "': larger than 16 MB, not a scene");
   std::ifstream in(file);
   if (!in) throw InputError("cannot open scene file '" + file + "': " + std::strerror(errno));
   std::ostringstream text;

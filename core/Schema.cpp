@@ -270,7 +270,16 @@ SourceLocation locationOf(const YAML::Mark& m, const std::string& file, bool wit
   return l;
 }
 
-ConfigNode convert(const YAML::Node& y, const std::string& file, bool withMarks, const SourceLocation& keyLoc) {
+/// Values a scene may expand to: far above any real scene (thousands), far below what YAML aliases
+/// nested a few levels deep can make of a kilobyte (each level multiplies).
+constexpr std::size_t kMaxSceneValues = 1000000;
+
+ConfigNode convert(const YAML::Node& y, const std::string& file, bool withMarks, const SourceLocation& keyLoc,
+                   std::size_t& values) {
+  if (++values > kMaxSceneValues)
+    throw InputError(locationOf(y.Mark(), file, withMarks),
+                     "the scene expands to more than " + std::to_string(kMaxSceneValues) +
+                         " values (YAML aliases nested inside each other?)");
   ConfigNode n;
   n.keyLoc = keyLoc;
   // yaml-cpp puts an empty value's mark on the next token, so an empty value points at its key.
@@ -285,7 +294,7 @@ ConfigNode convert(const YAML::Node& y, const std::string& file, bool withMarks,
       n.kind = ConfigNode::Kind::List;
       // A list item's "key" is the item itself: errors about a whole item point at its first line.
       for (const auto& item : y)
-        n.items.push_back(convert(item, file, withMarks, locationOf(item.Mark(), file, withMarks)));
+        n.items.push_back(convert(item, file, withMarks, locationOf(item.Mark(), file, withMarks), values));
       break;
     case YAML::NodeType::Map:
       n.kind = ConfigNode::Kind::Map;
@@ -297,7 +306,7 @@ ConfigNode convert(const YAML::Node& y, const std::string& file, bool withMarks,
           kl.key = name;
           throw InputError(kl, "duplicate key");
         }
-        n.items.push_back(convert(it->second, file, withMarks, kl));
+        n.items.push_back(convert(it->second, file, withMarks, kl, values));
         n.items.back().name = name;
       }
       break;
@@ -318,7 +327,8 @@ ConfigNode parseYaml(const std::string& text, const std::string& file, bool with
     throw InputError(l, "YAML syntax error: " + e.msg);
   }
   SourceLocation start{file, withMarks ? 1 : 0, withMarks ? 1 : 0, ""};
-  ConfigNode n = convert(root, file, withMarks, SourceLocation{file, 0, 0, ""});
+  std::size_t values = 0;
+  ConfigNode n = convert(root, file, withMarks, SourceLocation{file, 0, 0, ""}, values);
   if (n.loc.line == 0) n.loc = start;  // empty document
   return n;
 }

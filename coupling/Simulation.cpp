@@ -7,6 +7,11 @@
 
 namespace mfsi {
 
+namespace {
+/// Steps a scene may ask for: a billion-step run of the smallest scene takes weeks.
+constexpr double kMaxSteps = 1e9;
+}  // namespace
+
 Schema sceneSchema() {
   Schema s = Schema::map("a membrane-fsi scene");
   s.key("name", Schema::string("scene name (default: the file name)"), Default(""))
@@ -52,6 +57,15 @@ Simulation::Simulation(const SceneConfig& scene) {
   fieldOutput_.final = scene.get<bool>("output.fields.final");
   if (time_.endTime > 0 && time_.dt <= 0)
     throw InputError(scene.where("time.dt"), "a positive time step is needed when time.endTime > 0");
+  if (time_.endTime > 0) {
+    // Counted in floating point: endTime / dt may exceed what an integer holds.
+    double steps = std::ceil(time_.endTime / time_.dt - 1e-9);
+    if (time_.maxSteps > 0) steps = std::min(steps, double(time_.maxSteps));
+    if (!(steps <= kMaxSteps))
+      throw InputError(scene.where("time.dt"), "time.endTime / time.dt asks for " + formatReal(steps) +
+                                                   " steps, more than " + formatReal(kMaxSteps) +
+                                                   " (a larger dt, or time.maxSteps to stop earlier)");
+  }
 
   SimulationContext ctx;
   if (hasMesh_) {
@@ -124,8 +138,9 @@ RunResult Simulation::run(const std::string& outDir, bool terminal) {
   RunResult r;
   long long nSteps = 0;
   if (time_.endTime > 0) {
-    nSteps = static_cast<long long>(std::ceil(time_.endTime / time_.dt - 1e-9));
-    if (time_.maxSteps > 0) nSteps = std::min<long long>(nSteps, time_.maxSteps);
+    double steps = std::ceil(time_.endTime / time_.dt - 1e-9);  // <= kMaxSteps (checked at set-up)
+    if (time_.maxSteps > 0) steps = std::min(steps, double(time_.maxSteps));
+    nSteps = static_cast<long long>(steps);
   }
   std::vector<std::string> columns = {"step", "time", "wall_s"};
   for (const Module* m : reporting_)
