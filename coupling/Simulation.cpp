@@ -121,8 +121,8 @@ io::FieldFrame Simulation::fieldFrame(double time, long long step) {
     for (double c : io::hostValues(mesh_.cellNodes(), nCells)) g.cells.push_back(static_cast<std::int64_t>(c));
     RealView quality("mfsi::output::scaledJacobian", nCells);
     cellScaledJacobians(ExecSpace(), mesh_, quality);
-    g.addPointField("meshDisplacement", 3, std::move(d));
-    g.addCellField("scaledJacobian", 1, io::hostValues(quality, nCells));
+    g.addPointField("meshDisplacement", 3, std::move(d), true, true);
+    g.addCellField("scaledJacobian", 1, io::hostValues(quality, nCells), true, true);
     frame.grids.push_back(std::move(g));
   }
   // Parts first, then the module that owns them (the coupling moves a mounted membrane's grid to

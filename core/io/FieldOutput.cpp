@@ -132,14 +132,16 @@ void writeAtomically(const std::string& path, const std::string& text) {
 
 }  // namespace
 
-void OutputGrid::addPointField(std::string fieldName, int components, std::vector<double> values, bool vector) {
+void OutputGrid::addPointField(std::string fieldName, int components, std::vector<double> values, bool vector,
+                               bool geometric) {
   checkSize(*this, fieldName, components, nPoints(), values.size());
-  pointFields.push_back({std::move(fieldName), components, std::move(values), vector});
+  pointFields.push_back({std::move(fieldName), components, std::move(values), vector, geometric});
 }
 
-void OutputGrid::addCellField(std::string fieldName, int components, std::vector<double> values, bool vector) {
+void OutputGrid::addCellField(std::string fieldName, int components, std::vector<double> values, bool vector,
+                              bool geometric) {
   checkSize(*this, fieldName, components, nCells(), values.size());
-  cellFields.push_back({std::move(fieldName), components, std::move(values), vector});
+  cellFields.push_back({std::move(fieldName), components, std::move(values), vector, geometric});
 }
 
 OutputGrid* FieldFrame::find(const std::string& name) {
@@ -163,23 +165,64 @@ void FieldSeries::write(const FieldFrame& frame) {
   Hdf5File h5 = Hdf5File::create(dir_ + "/" + entry.file);
   h5.writeAttribute("time", frame.time);
   h5.writeAttribute("step", static_cast<double>(frame.step));
+  std::vector<std::pair<std::string, Written>> pending;
   for (const OutputGrid& g : frame.grids) {
-    const Topology topo = topologyOf(g);
+    Topology topo = topologyOf(g);
     const std::string root = "/" + g.name;
-    h5.write(root + "/points", g.points, {g.nPoints(), 3});
-    h5.write(root + "/topology", topo.values, topo.dims);
-    GridEntry ge{g.name, g.shape, g.nPoints(), g.nCells(), topo.values.size(), {}, {}};
-    for (const auto& f : g.pointFields) {
-      h5.write(root + "/point/" + f.name, f.values, shapeOf(g.nPoints(), f));
-      ge.pointFields.push_back({f.name, f.components, {}, f.vector});
+    const auto known = written_.find(g.name);
+    Written next;  // where this grid's points, cells and geometric fields are once this frame is on disk
+    GridEntry ge{g.name, g.shape, g.nPoints(), g.nCells(), topo.values.size(), {}, {}, {}};
+    const bool samePoints = known != written_.end() && known->second.points == g.points;
+    const bool sameCells = known != written_.end() && known->second.topology == topo.values;
+    if (samePoints) {
+      next.pointsFile = known->second.pointsFile;
+    } else {
+      h5.write(root + "/points", g.points, {g.nPoints(), 3});
+      next.pointsFile = entry.file;
+      next.points = g.points;
     }
-    for (const auto& f : g.cellFields) {
-      h5.write(root + "/cell/" + f.name, f.values, shapeOf(g.nCells(), f));
-      ge.cellFields.push_back({f.name, f.components, {}, f.vector});
+    if (sameCells) {
+      next.topologyFile = known->second.topologyFile;
+    } else {
+      h5.write(root + "/topology", topo.values, topo.dims);
+      next.topologyFile = entry.file;
+      next.topology = std::move(topo.values);
     }
+    ge.files["points"] = next.pointsFile;
+    ge.files["topology"] = next.topologyFile;
+    auto fields = [&](const std::vector<OutputField>& list, const std::string& group, std::size_t n,
+                      std::vector<OutputField>& into) {
+      for (const auto& f : list) {
+        const std::string key = group + "/" + f.name;
+        const std::string* earlier = nullptr;
+        if (f.geometric && samePoints && sameCells) {
+          const auto it = known->second.geometricFiles.find(key);
+          if (it != known->second.geometricFiles.end()) earlier = &it->second;
+        }
+        if (earlier) {
+          ge.files[key] = *earlier;
+        } else {
+          h5.write(root + "/" + key, f.values, shapeOf(n, f));
+          ge.files[key] = entry.file;
+        }
+        if (f.geometric) next.geometricFiles[key] = ge.files[key];
+        into.push_back({f.name, f.components, {}, f.vector, f.geometric});
+      }
+    };
+    fields(g.pointFields, "point", g.nPoints(), ge.pointFields);
+    fields(g.cellFields, "cell", g.nCells(), ge.cellFields);
+    pending.emplace_back(g.name, std::move(next));
     entry.grids.push_back(std::move(ge));
   }
   h5.commit();
+  for (auto& [name, next] : pending) {  // only once the frame is on disk
+    Written& w = written_[name];
+    if (next.pointsFile == entry.file) w.points = std::move(next.points);
+    if (next.topologyFile == entry.file) w.topology = std::move(next.topology);
+    w.pointsFile = next.pointsFile;
+    w.topologyFile = next.topologyFile;
+    w.geometricFiles = std::move(next.geometricFiles);
+  }
   entries_.push_back(std::move(entry));
   writeAtomically(indexPath_, xdmf());
 }
@@ -198,10 +241,10 @@ std::string FieldSeries::xdmf() const {
     for (const auto& e : entries_) {
       for (const auto& g : e.grids) {
         if (g.name != gridName) continue;
-        const std::string h5 = e.file + ":/" + g.name;
         auto item = [&](const std::string& path, const std::string& dims, const char* type) {
+          const std::string& file = g.files.at(path.substr(1));
           return "<DataItem Dimensions=\"" + dims + "\" NumberType=\"" + type + "\" Precision=\"8\" Format=\"HDF\">" +
-                 xml(h5 + path) + "</DataItem>";
+                 xml(file + ":/" + g.name + path) + "</DataItem>";
         };
         std::string type, topoDims = std::to_string(g.topologySize);
         switch (g.shape) {

@@ -5,9 +5,11 @@
 /// file (`fields.xdmf`) lists them as time series, so ParaView opens the whole run as one dataset.
 ///
 /// The modules fill a FieldFrame on the host (positions, cells and fields as plain arrays); the
-/// series writes it. Both files of an output time are written under temporary names and renamed,
+/// series writes it. A grid's points and cells are written when they change and otherwise referred
+/// to where they were written (a fixed mesh: once, in the first frame). Both files of an output time are written under temporary names and renamed,
 /// so an interrupted run leaves the frames it finished and an XDMF file that lists exactly those.
 #include <cstdint>
+#include <map>
 #include <string>
 #include <vector>
 
@@ -16,11 +18,14 @@ namespace mfsi::io {
 /// \brief One field on a grid: `components` values per point or per cell, point or cell major.
 /// Three components are a vector (ParaView draws glyphs of it) unless `vector` is false (e.g. the
 /// in-plane strain E11, E22, E12).
+/// A `geometric` field depends on nothing but the grid's points and cells (mesh displacement, cell
+/// quality): while those do not change it is not written again.
 struct OutputField {
   std::string name;
   int components = 1;
   std::vector<double> values;
   bool vector = true;
+  bool geometric = false;
 };
 
 /// How a grid's cells are given.
@@ -42,8 +47,10 @@ struct OutputGrid {
   std::size_t nPoints() const { return points.size() / 3; }
   std::size_t nCells() const;
   /// Add a field; throws std::logic_error when its size does not match the grid.
-  void addPointField(std::string fieldName, int components, std::vector<double> values, bool vector = true);
-  void addCellField(std::string fieldName, int components, std::vector<double> values, bool vector = true);
+  void addPointField(std::string fieldName, int components, std::vector<double> values, bool vector = true,
+                     bool geometric = false);
+  void addCellField(std::string fieldName, int components, std::vector<double> values, bool vector = true,
+                    bool geometric = false);
 };
 
 /// \brief Everything written at one output time.
@@ -73,6 +80,9 @@ class FieldSeries {
     std::string name;
     CellShape shape;
     std::size_t nPoints, nCells, topologySize;
+    /// The frame file that holds each dataset ("points", "topology", "point/U", ...): this frame's,
+    /// or an earlier one's for what did not change.
+    std::map<std::string, std::string> files;
     std::vector<OutputField> pointFields, cellFields;  ///< names and components (no values)
   };
   struct Entry {
@@ -82,9 +92,19 @@ class FieldSeries {
   };
   std::string xdmf() const;
 
+  /// The last points and cells written of each grid, and where: a frame whose grid has not moved
+  /// (or not changed its cells) refers to them instead of writing them again.
+  struct Written {
+    std::string pointsFile, topologyFile;
+    std::vector<double> points;
+    std::vector<std::int64_t> topology;
+    std::map<std::string, std::string> geometricFiles;  ///< "point/<name>", "cell/<name>" -> file
+  };
+
   std::string dir_;
   std::string indexPath_;
   std::vector<Entry> entries_;
+  std::map<std::string, Written> written_;
 };
 
 }  // namespace mfsi::io

@@ -94,7 +94,10 @@ TEST(FieldOutputScene, TheCavitysFramesHoldTheSolversStateBitForBit) {
   for (mfsi::lid_t i = 0; i < mm.nNodes(); ++i)
     for (int k = 0; k < 3; ++k) EXPECT_EQ(mp[3 * i + k], mm.hostPoints()[i][k] + u[3 * i + k]);
   EXPECT_EQ(h5.readDoubles(m + "/cell/vonMises").size(), static_cast<std::size_t>(mm.nElements()));
-  EXPECT_EQ(h5.readInts(m + "/topology").size(), 4u * mm.nElements());  // all quads
+  // All quads; the cells never change, so the first frame holds them for every frame.
+  EXPECT_FALSE(h5.has(m + "/topology"));
+  EXPECT_EQ(Hdf5File::openRead(dir + "/fields/fields_000000.h5").readInts(m + "/topology").size(),
+            4u * mm.nElements());
 
   std::ifstream in(dir + "/fields.xdmf");
   std::stringstream x;

@@ -118,11 +118,15 @@ TEST(FieldSeries, FramesReadBackAndTheIndexListsEachGridOverTime) {
   EXPECT_EQ(dims, (std::vector<std::size_t>{1, 3}));
   EXPECT_EQ(h5.readDoubles("/mesh/cell/p", &dims), (std::vector<double>{6.0}));
   EXPECT_EQ(dims, (std::vector<std::size_t>{1}));  // a scalar field is one-dimensional
-  EXPECT_EQ(h5.readDoubles("/mesh/points")[3 * 6 + 0], 2.0);
-  EXPECT_EQ(h5.readInts("/mesh/topology", &dims), (std::vector<std::int64_t>{0, 1, 2, 3, 4, 5, 6, 7}));
+  EXPECT_EQ(h5.readDoubles("/mesh/points")[3 * 6 + 0], 2.0);  // the mesh moved: its points are written
+  // Unchanged cells and the membrane's unmoved points are not written again: the first frame has them.
+  EXPECT_FALSE(h5.has("/mesh/topology"));
+  EXPECT_FALSE(h5.has("/membrane/points"));
+  const Hdf5File first = Hdf5File::openRead(series.framePath(0));
+  EXPECT_EQ(first.readInts("/mesh/topology", &dims), (std::vector<std::int64_t>{0, 1, 2, 3, 4, 5, 6, 7}));
   EXPECT_EQ(dims, (std::vector<std::size_t>{1, 8}));
   // XDMF's mixed list: type 5 (quadrilateral) and its 4 nodes, type 4 (triangle) and its 3 nodes.
-  EXPECT_EQ(h5.readInts("/membrane/topology"), (std::vector<std::int64_t>{5, 0, 1, 2, 3, 4, 1, 4, 2}));
+  EXPECT_EQ(first.readInts("/membrane/topology"), (std::vector<std::int64_t>{5, 0, 1, 2, 3, 4, 1, 4, 2}));
 
   const std::string x = read(series.indexPath());
   EXPECT_EQ(count(x, "CollectionType=\"Temporal\""), 2);  // one series per grid
@@ -132,6 +136,10 @@ TEST(FieldSeries, FramesReadBackAndTheIndexListsEachGridOverTime) {
   EXPECT_EQ(count(x, "TopologyType=\"Mixed\" NumberOfElements=\"2\""), 2);
   EXPECT_EQ(count(x, "Dimensions=\"9\" NumberType=\"Int\""), 2);
   EXPECT_NE(x.find("fields/fields_000005.h5:/mesh/cell/U</DataItem>"), std::string::npos);
+  EXPECT_NE(x.find("fields/fields_000005.h5:/mesh/points</DataItem>"), std::string::npos);
+  EXPECT_EQ(count(x, "fields/fields_000000.h5:/mesh/topology</DataItem>"), 2);
+  EXPECT_EQ(count(x, "fields/fields_000000.h5:/membrane/points</DataItem>"), 2);
+  EXPECT_EQ(count(x, "fields/fields_000005.h5:/membrane/points"), 0);
   EXPECT_NE(x.find("Name=\"U\" AttributeType=\"Vector\" Center=\"Cell\""), std::string::npos);
   EXPECT_NE(x.find("Name=\"strain\" AttributeType=\"Matrix\" Center=\"Cell\""), std::string::npos);
   EXPECT_NE(x.find("Name=\"meshDisplacement\" AttributeType=\"Vector\" Center=\"Node\""), std::string::npos);
@@ -162,4 +170,40 @@ TEST(FieldSeries, AFolderThatCannotBeWrittenStopsWithAnOutputError) {
   EXPECT_THROW(series.write(frame(0.0, 0, 1.0)), mfsi::OutputError);
   EXPECT_EQ(series.frames(), 0);
   EXPECT_FALSE(fs::exists(series.indexPath()));
+}
+
+TEST(FieldSeries, WhatDependsOnAnUnmovedMeshIsWrittenOnceAndWrittenAgainWhenItMoves) {
+  const std::string dir = mfsi::test::freshDir("field_output_geometric");
+  FieldSeries series(dir);
+  auto grid = [](double x1, double p) {
+    FieldFrame f;
+    OutputGrid g;
+    g.name = "g";
+    g.shape = CellShape::Surface;
+    g.points = {0, 0, 0, x1, 0, 0, x1, 1, 0, 0, 1, 0};
+    g.cells = {0, 1, 2, 3};
+    g.addCellField("p", 1, {p});
+    g.addCellField("quality", 1, {x1}, true, true);
+    f.grids.push_back(g);
+    return f;
+  };
+  FieldFrame a = grid(1.0, 1.0), b = grid(1.0, 2.0), c = grid(1.5, 3.0);
+  b.step = 1;
+  c.step = 2;
+  series.write(a);
+  series.write(b);
+  series.write(c);
+  const Hdf5File f1 = Hdf5File::openRead(series.framePath(1));
+  EXPECT_EQ(f1.readDoubles("/g/cell/p"), (std::vector<double>{2.0}));
+  EXPECT_FALSE(f1.has("/g/cell/quality"));
+  EXPECT_FALSE(f1.has("/g/points"));
+  const Hdf5File f2 = Hdf5File::openRead(series.framePath(2));
+  EXPECT_EQ(f2.readDoubles("/g/cell/quality"), (std::vector<double>{1.5}));  // the grid moved
+  EXPECT_EQ(f2.readDoubles("/g/points")[3], 1.5);
+  EXPECT_FALSE(f2.has("/g/topology"));
+  const std::string x = read(series.indexPath());
+  EXPECT_EQ(count(x, "fields/fields_000000.h5:/g/cell/quality<"), 2);
+  EXPECT_EQ(count(x, "fields/fields_000002.h5:/g/cell/quality<"), 1);
+  EXPECT_EQ(count(x, "fields/fields_000000.h5:/g/topology<"), 3);
+  EXPECT_EQ(count(x, "fields/fields_000001.h5:/g/cell/p<"), 1);
 }
