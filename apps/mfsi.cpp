@@ -169,12 +169,7 @@ int commandRun(const std::string& sceneArg, const std::vector<std::string>& sets
       summary.cells = sim->mesh().nCells();
       summary.nodes = sim->mesh().nNodes();
     }
-    {
-      std::ofstream s(out + "/scene.yaml");
-      s << resolved;
-      s.flush();
-      if (!s) throw mfsi::OutputError("cannot write '" + out + "/scene.yaml'");
-    }
+    mfsi::writeTextAtomically(out + "/scene.yaml", resolved);
     const auto result = sim->run(out, rank == 0 && mfsi::stdoutIsTerminal());
     summary.steps = result.steps;
     summary.simTime = result.simTime;

@@ -50,6 +50,16 @@ void computeGeometry(const ExecSpace& exec, const HexMesh& mesh, const MeshGeome
       });
 }
 
+namespace {
+/// The minimum scaled Jacobian over the corners of cell c at the current points.
+KOKKOS_INLINE_FUNCTION double cellMinScaledJacobian(const ConstReal3View& pts, const ConstHex8View& cn, lid_t c) {
+  double x[8][3];
+  for (int a = 0; a < 8; ++a)
+    for (int k = 0; k < 3; ++k) x[a][k] = pts(cn(c, a), k);
+  return geom::hexMinScaledJacobian(x);
+}
+}  // namespace
+
 double minScaledJacobian(const ExecSpace& exec, const HexMesh& mesh) {
   ConstReal3View pts = mesh.points();
   ConstHex8View cn = mesh.cellNodes();
@@ -57,10 +67,7 @@ double minScaledJacobian(const ExecSpace& exec, const HexMesh& mesh) {
   Kokkos::parallel_reduce(
       "mfsi::core::quality::minScaledJacobian", RangePolicy(exec, 0, mesh.nCells()),
       KOKKOS_LAMBDA(lid_t c, double& m) {
-        double x[8][3];
-        for (int a = 0; a < 8; ++a)
-          for (int k = 0; k < 3; ++k) x[a][k] = pts(cn(c, a), k);
-        const double j = geom::hexMinScaledJacobian(x);
+        const double j = cellMinScaledJacobian(pts, cn, c);
         m = j < m ? j : m;
       },
       Kokkos::Min<double>(jmin));
@@ -72,12 +79,8 @@ void cellScaledJacobians(const ExecSpace& exec, const HexMesh& mesh, const RealV
   ConstReal3View pts = mesh.points();
   ConstHex8View cn = mesh.cellNodes();
   Kokkos::parallel_for(
-      "mfsi::core::quality::cellScaledJacobians", RangePolicy(exec, 0, mesh.nCells()), KOKKOS_LAMBDA(lid_t c) {
-        double x[8][3];
-        for (int a = 0; a < 8; ++a)
-          for (int k = 0; k < 3; ++k) x[a][k] = pts(cn(c, a), k);
-        out(c) = geom::hexMinScaledJacobian(x);
-      });
+      "mfsi::core::quality::cellScaledJacobians", RangePolicy(exec, 0, mesh.nCells()),
+      KOKKOS_LAMBDA(lid_t c) { out(c) = cellMinScaledJacobian(pts, cn, c); });
 }
 
 MeshQuality computeQuality(const ExecSpace& exec, const HexMesh& mesh, const MeshGeometry& geo) {

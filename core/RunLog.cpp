@@ -71,13 +71,11 @@ std::string toJson(const RunSummary& s) {
   return os.str();
 }
 
-void writeSummary(const std::string& dir, const RunSummary& s) {
-  std::filesystem::create_directories(dir);
-  const std::string path = dir + "/summary.json";
-  const std::string tmp = path + ".tmp";
+void writeTextAtomically(const std::string& path, const std::string& text) {
+  const std::string tmp = path + ".part";
   {
-    std::ofstream out(tmp);
-    out << toJson(s);
+    std::ofstream out(tmp, std::ios::binary | std::ios::trunc);
+    out << text;
     out.flush();
     if (!out) {
       out.close();
@@ -89,6 +87,11 @@ void writeSummary(const std::string& dir, const RunSummary& s) {
   std::error_code ec;
   std::filesystem::rename(tmp, path, ec);
   if (ec) throw OutputError("cannot rename '" + tmp + "' to '" + path + "': " + ec.message());
+}
+
+void writeSummary(const std::string& dir, const RunSummary& s) {
+  std::filesystem::create_directories(dir);
+  writeTextAtomically(dir + "/summary.json", toJson(s));
 }
 
 StepLog::StepLog(const std::string& path, std::vector<std::string> columns)

@@ -32,6 +32,10 @@ struct RunSummary {
 /// JSON text of a summary (non-finite numbers are written as null).
 std::string toJson(const RunSummary& s);
 
+/// Write `text` to `path` through a temporary file (`<path>.part`) and a rename, so the file is
+/// never half-written. Throws OutputError when the write or the rename fails.
+void writeTextAtomically(const std::string& path, const std::string& text);
+
 /// Write `dir/summary.json` atomically (temporary file + rename); creates `dir`.
 void writeSummary(const std::string& dir, const RunSummary& s);
 

@@ -65,6 +65,7 @@ Simulation::Simulation(const SceneConfig& scene) {
       throw InputError(scene.where("time.dt"), "time.endTime / time.dt asks for " + formatReal(steps) +
                                                    " steps, more than " + formatReal(kMaxSteps) +
                                                    " (a larger dt, or time.maxSteps to stop earlier)");
+    nSteps_ = static_cast<long long>(steps);
   }
 
   SimulationContext ctx;
@@ -136,12 +137,7 @@ io::FieldFrame Simulation::fieldFrame(double time, long long step) {
 
 RunResult Simulation::run(const std::string& outDir, bool terminal) {
   RunResult r;
-  long long nSteps = 0;
-  if (time_.endTime > 0) {
-    double steps = std::ceil(time_.endTime / time_.dt - 1e-9);  // <= kMaxSteps (checked at set-up)
-    if (time_.maxSteps > 0) steps = std::min(steps, double(time_.maxSteps));
-    nSteps = static_cast<long long>(steps);
-  }
+  const long long nSteps = nSteps_;
   std::vector<std::string> columns = {"step", "time", "wall_s"};
   for (const Module* m : reporting_)
     for (const auto& c : m->stepColumns()) columns.push_back(m->name() + "." + c);

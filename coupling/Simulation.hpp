@@ -61,6 +61,7 @@ class Simulation {
   HexMesh mesh_;
   MeshGeometry geometry_;
   TimeOptions time_;
+  long long nSteps_ = 0;  ///< from time_ (checked at set-up)
   FieldOutputOptions fieldOutput_;
   std::vector<std::unique_ptr<Module>> modules_;  ///< advanced by the driver
   std::vector<Module*> reporting_;                ///< modules_ and their parts: output, columns, metrics

@@ -1,12 +1,12 @@
 #include "core/io/FieldOutput.hpp"
 
 #include "core/Error.hpp"
+#include "core/RunLog.hpp"
 #include "core/io/Hdf5File.hpp"
 
 #include <algorithm>
 #include <cstdio>
 #include <filesystem>
-#include <fstream>
 #include <iomanip>
 #include <sstream>
 #include <stdexcept>
@@ -38,7 +38,6 @@ struct Topology {
   std::string type;
   std::vector<std::int64_t> values;
   std::vector<std::size_t> dims;
-  int nodesPerElement = 0;
 };
 
 Topology topologyOf(const OutputGrid& g) {
@@ -52,7 +51,6 @@ Topology topologyOf(const OutputGrid& g) {
   }
   if (g.shape == CellShape::Point) {
     t.type = "Polyvertex";
-    t.nodesPerElement = 1;
     for (std::size_t i = 0; i < n; ++i) t.values.push_back(static_cast<std::int64_t>(i));
     t.dims = {n};
     return t;
@@ -111,25 +109,6 @@ std::string number(double v) {
   return os.str();
 }
 
-/// Write `text` to `path` through a temporary file and a rename; OutputError on any failure.
-void writeAtomically(const std::string& path, const std::string& text) {
-  const std::string tmp = path + ".part";
-  {
-    std::ofstream out(tmp, std::ios::binary | std::ios::trunc);
-    out << text;
-    out.flush();
-    if (!out) {
-      out.close();
-      std::error_code ec;
-      fs::remove(tmp, ec);
-      throw OutputError("cannot write '" + tmp + "' (is the disk full?)");
-    }
-  }
-  std::error_code ec;
-  fs::rename(tmp, path, ec);
-  if (ec) throw OutputError("cannot rename '" + tmp + "' to '" + path + "': " + ec.message());
-}
-
 }  // namespace
 
 void OutputGrid::addPointField(std::string fieldName, int components, std::vector<double> values, bool vector,
@@ -171,7 +150,9 @@ void FieldSeries::write(const FieldFrame& frame) {
     const std::string root = "/" + g.name;
     const auto known = written_.find(g.name);
     Written next;  // where this grid's points, cells and geometric fields are once this frame is on disk
-    GridEntry ge{g.name, g.shape, g.nPoints(), g.nCells(), topo.values.size(), {}, {}, {}};
+    std::string topologyDims;
+    for (std::size_t d : topo.dims) topologyDims += (topologyDims.empty() ? "" : " ") + std::to_string(d);
+    GridEntry ge{g.name, g.shape, g.nPoints(), g.nCells(), topo.type, topologyDims, {}, {}, {}};
     const bool samePoints = known != written_.end() && known->second.points == g.points;
     const bool sameCells = known != written_.end() && known->second.topology == topo.values;
     if (samePoints) {
@@ -224,7 +205,7 @@ void FieldSeries::write(const FieldFrame& frame) {
     w.geometricFiles = std::move(next.geometricFiles);
   }
   entries_.push_back(std::move(entry));
-  writeAtomically(indexPath_, xdmf());
+  writeTextAtomically(indexPath_, xdmf());
 }
 
 std::string FieldSeries::xdmf() const {
@@ -246,27 +227,11 @@ std::string FieldSeries::xdmf() const {
           return "<DataItem Dimensions=\"" + dims + "\" NumberType=\"" + type + "\" Precision=\"8\" Format=\"HDF\">" +
                  xml(file + ":/" + g.name + path) + "</DataItem>";
         };
-        std::string type, topoDims = std::to_string(g.topologySize);
-        switch (g.shape) {
-          case CellShape::Hexahedron: type = "Hexahedron"; topoDims = std::to_string(g.nCells) + " 8"; break;
-          case CellShape::Point: type = "Polyvertex"; break;
-          case CellShape::Surface:
-            if (g.topologySize == 4 * g.nCells) {
-              type = "Quadrilateral";
-              topoDims = std::to_string(g.nCells) + " 4";
-            } else if (g.topologySize == 3 * g.nCells) {
-              type = "Triangle";
-              topoDims = std::to_string(g.nCells) + " 3";
-            } else {
-              type = "Mixed";
-            }
-            break;
-        }
         x << "      <Grid Name=\"" << xml(g.name) << "\" GridType=\"Uniform\">\n"
           << "        <Time Value=\"" << number(e.time) << "\"/>\n"
-          << "        <Topology TopologyType=\"" << type << "\" NumberOfElements=\"" << g.nCells << "\""
+          << "        <Topology TopologyType=\"" << g.topologyType << "\" NumberOfElements=\"" << g.nCells << "\""
           << (g.shape == CellShape::Point ? " NodesPerElement=\"1\"" : "") << ">\n"
-          << "          " << item("/topology", topoDims, "Int") << "\n        </Topology>\n"
+          << "          " << item("/topology", g.topologyDims, "Int") << "\n        </Topology>\n"
           << "        <Geometry GeometryType=\"XYZ\">\n"
           << "          " << item("/points", std::to_string(g.nPoints) + " 3", "Float") << "\n        </Geometry>\n";
         auto attributes = [&](const std::vector<OutputField>& fields, const char* center, const char* group,

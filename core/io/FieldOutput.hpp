@@ -79,7 +79,8 @@ class FieldSeries {
   struct GridEntry {
     std::string name;
     CellShape shape;
-    std::size_t nPoints, nCells, topologySize;
+    std::size_t nPoints, nCells;
+    std::string topologyType, topologyDims;  ///< XDMF's TopologyType and the dataset's Dimensions
     /// The frame file that holds each dataset ("points", "topology", "point/U", ...): this frame's,
     /// or an earlier one's for what did not change.
     std::map<std::string, std::string> files;
