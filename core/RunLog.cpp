@@ -103,6 +103,33 @@ StepLog::StepLog(const std::string& path, std::vector<std::string> columns)
   if (!out_) throw OutputError("cannot write '" + path + "' (is the disk full?)");
 }
 
+void keepCsvRows(const std::string& path, const std::string& header, long long rows) {
+  std::ifstream in(path);
+  if (!in) throw InputError("restart: '" + path + "' is missing: the run to continue did not write it");
+  std::string line, kept;
+  if (!std::getline(in, line) || line != header)
+    throw InputError("restart: '" + path + "' has other columns than this run writes (another scene?)");
+  kept = line + "\n";
+  long long n = 0;
+  while (n < rows && std::getline(in, line)) {
+    kept += line + "\n";
+    ++n;
+  }
+  if (n < rows)
+    throw InputError("restart: '" + path + "' has " + std::to_string(n) + " rows, the checkpoint needs " +
+                     std::to_string(rows));
+  writeTextAtomically(path, kept);
+}
+
+StepLog::StepLog(const std::string& path, std::vector<std::string> columns, long long keepRows)
+    : path_(path), nColumns_(columns.size()) {
+  std::string header;
+  for (std::size_t i = 0; i < columns.size(); ++i) header += (i ? "," : "") + columns[i];
+  keepCsvRows(path, header, keepRows);
+  out_.open(path, std::ios::app);
+  if (!out_) throw OutputError("cannot write '" + path + "'");
+}
+
 void StepLog::row(const std::vector<double>& values) {
   MFSI_ASSERT(values.size() == nColumns_, "step log row has " << values.size() << " values for " << nColumns_);
   out_ << std::setprecision(12);

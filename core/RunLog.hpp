@@ -43,10 +43,19 @@ void writeSummary(const std::string& dir, const RunSummary& s);
 std::string jsonEscape(const std::string& s);
 
 /// \brief Per-step CSV log (`steps.csv`): a header of column names, then one row per step.
+/// Keep the header line (which must be `header`) and the first `rows` data lines of a CSV file and
+/// drop the rest, atomically (the rows a run wrote after the checkpoint it is restarted from).
+/// Throws InputError naming the file when it is missing, has another header or fewer rows.
+void keepCsvRows(const std::string& path, const std::string& header, long long rows);
+
 class StepLog {
  public:
   StepLog() = default;
   StepLog(const std::string& path, std::vector<std::string> columns);
+  /// Continue the log of a run restarted from a checkpoint in the same folder: keep its first
+  /// `keepRows` rows (the steps up to the checkpoint), drop the later ones, append from there.
+  /// Throws InputError when the file is missing, has other columns or fewer rows.
+  StepLog(const std::string& path, std::vector<std::string> columns, long long keepRows);
   /// Append a row and flush it (a stopped run keeps every step it finished). Throws OutputError
   /// when the write fails.
   void row(const std::vector<double>& values);

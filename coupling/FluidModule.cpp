@@ -193,4 +193,12 @@ ModuleEntry fluidModuleEntry() {
           }};
 }
 
+void FluidModule::saveState(io::StateWriter& /*w*/) const {
+  throw InputError(name() + ": checkpoints are not available for this module yet");
+}
+
+void FluidModule::loadState(const io::StateReader& /*r*/) {
+  throw InputError(name() + ": restart is not available for this module yet");
+}
+
 }  // namespace mfsi

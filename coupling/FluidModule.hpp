@@ -16,6 +16,8 @@ class FluidModule final : public Module {
   /// One time step (steady: `pimple.outerCorrectors` SIMPLE iterations). Throws DivergenceError
   /// when the solver reports a breakdown or non-finite fields.
   void advance(const TimeState& t) override;
+  void saveState(io::StateWriter& w) const override;
+  void loadState(const io::StateReader& r) override;
   /// The steps of advance, for a module that iterates the fluid within a step (the coupling):
   /// beginStep, then solveIteration once per coupling iteration (PIMPLE on the current mesh and
   /// wall velocities, from the current iterate). solveIteration throws DivergenceError like advance.

@@ -77,7 +77,7 @@ void MembraneModule::check(const MembraneSolveReport& report, const char* what, 
   sample();
 }
 
-void MembraneModule::openOutput(const std::string& /*dir*/) {
+void MembraneModule::openOutput(const std::string& /*dir*/, const OutputStart& /*start*/) {
   if (panel_.analysis != MembraneAnalysis::Static || solved_) return;
   check(solver_->solveStatic(0), "static solve", 0);
   solved_ = true;
@@ -170,6 +170,14 @@ ModuleEntry membraneModuleEntry() {
             for (const auto& panel : readMembraneOptions(section, ctx.mesh)) v.push_back(std::make_unique<MembraneModule>(panel));
             return v;
           }};
+}
+
+void MembraneModule::saveState(io::StateWriter& /*w*/) const {
+  throw InputError(name() + ": checkpoints are not available for this module yet");
+}
+
+void MembraneModule::loadState(const io::StateReader& /*r*/) {
+  throw InputError(name() + ": restart is not available for this module yet");
 }
 
 }  // namespace mfsi

@@ -22,6 +22,10 @@ class MembraneModule final : public Module {
   explicit MembraneModule(const MembranePanelOptions& options);
 
   void advance(const TimeState& t) override;
+
+  void saveState(io::StateWriter& w) const override;
+
+  void loadState(const io::StateReader& r) override;
   /// "<name>.<summary key>" for every entry of MembraneSolver::summary(), and the comparison with
   /// the reference solution: hencky_w0 and hencky_rel_err, or period, period_exact and period_rel_err.
   void addMetrics(std::map<std::string, double>& metrics) const override;
@@ -31,7 +35,7 @@ class MembraneModule final : public Module {
   /// (0 taut, 1 wrinkled, 2 slack).
   void addOutputFields(io::FieldFrame& frame) override;
   /// Solves the t = 0 equilibrium of a static panel (the run is starting).
-  void openOutput(const std::string& dir) override;
+  void openOutput(const std::string& dir, const OutputStart& start) override;
   std::vector<std::string> stepColumns() const override;
   void appendStepValues(std::vector<double>& values) const override;
 

@@ -11,6 +11,7 @@
 #include "core/MeshGeometry.hpp"
 #include "core/SceneConfig.hpp"
 #include "core/Timers.hpp"
+#include "core/io/Checkpoint.hpp"
 #include "core/io/FieldOutput.hpp"
 
 #include <functional>
@@ -30,6 +31,14 @@ struct SimulationContext {
   std::vector<std::unique_ptr<class Module>>* built = nullptr;
 };
 
+/// \brief Where a run's output starts: a new run at step 0, or a run restarted from a checkpoint
+/// at `step` that continues the files of the run in the same folder (`continueFiles`: keep their
+/// rows up to `step`, drop the later ones) or starts new ones in another folder.
+struct OutputStart {
+  long long step = 0;
+  bool continueFiles = false;
+};
+
 class Module {
  public:
   explicit Module(std::string name);
@@ -43,13 +52,19 @@ class Module {
   /// Named summary numbers for summary.json ("<module>.<what>").
   virtual void addMetrics(std::map<std::string, double>& /*metrics*/) const {}
   /// Open the module's own output files in the run's output folder (before the first step).
-  virtual void openOutput(const std::string& /*dir*/) {}
+  virtual void openOutput(const std::string& /*dir*/, const OutputStart& /*start*/) {}
   /// Add this module's fields to an output frame: a grid of its own (a membrane, the bodies) or
   /// fields on another's (the fluid's U and p on the scene mesh's grid "mesh").
   virtual void addOutputFields(io::FieldFrame& /*frame*/) {}
   /// Column names and values of this module in steps.csv.
   virtual std::vector<std::string> stepColumns() const { return {}; }
   virtual void appendStepValues(std::vector<double>& /*values*/) const {}
+  /// Write everything this module needs to continue the run *bitwise* from the end of the last
+  /// completed step (fields, old time levels, solver guesses and caches that a step reads).
+  virtual void saveState(io::StateWriter& w) const = 0;
+  /// Read back what saveState wrote, into a module built from the same scene. Throws InputError
+  /// (naming the checkpoint and dataset) when the checkpoint does not fit this module.
+  virtual void loadState(const io::StateReader& r) = 0;
   /// Modules this one owns and advances itself (the coupling's fluid and membranes): the driver
   /// asks them for output, columns and metrics, but never advances them.
   virtual std::vector<Module*> parts() { return {}; }

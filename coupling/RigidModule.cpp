@@ -50,7 +50,7 @@ void RigidModule::addMetrics(std::map<std::string, double>& metrics) const {
   metrics["bodies.maxEnergyDrift"] = maxEnergyDrift_;
 }
 
-void RigidModule::openOutput(const std::string& dir) {
+void RigidModule::openOutput(const std::string& dir, const OutputStart& /*start*/) {
   csv_.open(dir + "/bodies.csv");
   RigidBodySystem::writeCsvHeader(csv_);
   system_.writeCsvRows(csv_);
@@ -70,6 +70,14 @@ ModuleEntry rigidModuleEntry() {
             v.push_back(std::make_unique<RigidModule>(readRigidOptions(section)));
             return v;
           }};
+}
+
+void RigidModule::saveState(io::StateWriter& /*w*/) const {
+  throw InputError(name() + ": checkpoints are not available for this module yet");
+}
+
+void RigidModule::loadState(const io::StateReader& /*r*/) {
+  throw InputError(name() + ": restart is not available for this module yet");
 }
 
 }  // namespace mfsi

@@ -12,11 +12,13 @@ class RigidModule final : public Module {
  public:
   explicit RigidModule(const RigidSystemOptions& options);
   void advance(const TimeState& t) override;
+  void saveState(io::StateWriter& w) const override;
+  void loadState(const io::StateReader& r) override;
   void addMetrics(std::map<std::string, double>& metrics) const override;
   /// The grid "bodies": one point per body at its centre of mass, with its velocity, angular
   /// velocity, (roll, pitch, yaw), force and moment.
   void addOutputFields(io::FieldFrame& frame) override;
-  void openOutput(const std::string& dir) override;
+  void openOutput(const std::string& dir, const OutputStart& start) override;
   std::vector<std::string> stepColumns() const override;
   void appendStepValues(std::vector<double>& values) const override;
 

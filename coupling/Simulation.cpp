@@ -142,7 +142,7 @@ RunResult Simulation::run(const std::string& outDir, bool terminal) {
   for (const Module* m : reporting_)
     for (const auto& c : m->stepColumns()) columns.push_back(m->name() + "." + c);
   StepLog log(outDir + "/steps.csv", columns);
-  for (Module* m : reporting_) m->openOutput(outDir);
+  for (Module* m : reporting_) m->openOutput(outDir, OutputStart{});
   Progress progress(nSteps, time_.endTime, terminal);
   TimeState ts;
   ts.endTime = time_.endTime;

@@ -665,4 +665,12 @@ ModuleEntry couplingModuleEntry() {
           }};
 }
 
+void FsiCoupling::saveState(io::StateWriter& /*w*/) const {
+  throw InputError(name() + ": checkpoints are not available for this module yet");
+}
+
+void FsiCoupling::loadState(const io::StateReader& /*r*/) {
+  throw InputError(name() + ": restart is not available for this module yet");
+}
+
 }  // namespace mfsi

@@ -53,6 +53,10 @@ class FsiCoupling final : public Module {
               std::unique_ptr<RigidModule> rigid = nullptr);
 
   void advance(const TimeState& t) override;
+
+  void saveState(io::StateWriter& w) const override;
+
+  void loadState(const io::StateReader& r) override;
   void addMetrics(std::map<std::string, double>& metrics) const override;
   std::vector<std::string> stepColumns() const override;
   void appendStepValues(std::vector<double>& values) const override;
