@@ -2,18 +2,23 @@
 //
 //   mfsi run                                  # the default scene (membrane-channel), results in results/<scene>/
 //   mfsi run cases/box.yaml --out /tmp/box --threads 2 [--overwrite]
+//   mfsi run --restart /tmp/box               # continue a run from its latest checkpoint
 //   mfsi run box --set mesh.blocks.0.cells=[32,32,8]
 //   mfsi check cases/box.yaml                 # validate without running (also builds the mesh)
 //   mfsi check --describe                     # every scene key with type, default, units, doc
 //   mfsi scenes                               # built-in scenes
+//   mfsi plot /tmp/box [--out DIR]            # PNGs of a run's time series (and a 2D field) in /tmp/box/plots/
 //   mfsi --version
 //
 // Exit codes: 0 ok, 2 bad input (scene, mesh, command line), 3 diverged, 4 results could not be
-// saved (a failed write), 1 internal error.
+// saved (a failed write), 1 internal error, 130 / 143 stopped by SIGINT / SIGTERM (after a
+// checkpoint: continue with --restart).
 // Every `run` writes <out>/summary.json (also on errors), <out>/scene.yaml and <out>/steps.csv (and
 // fields.xdmf with fields/ as the scene's `output` asks); a folder that holds an earlier run's
 // results is refused (exit 2, nothing written) unless --overwrite.
+#include "Plot.hpp"
 #include "coupling/Simulation.hpp"
+#include "core/Interrupt.hpp"
 #include "core/RunLog.hpp"
 
 #include <CLI/CLI.hpp>
@@ -135,8 +140,33 @@ void prepareOutput(const std::string& out, bool overwrite) {
   fs::remove(probe, ec);
 }
 
-int commandRun(const std::string& sceneArg, const std::vector<std::string>& sets, std::string out, bool overwrite) {
+/// Same folder (both exist and are one)?
+bool sameFolder(const std::string& a, const std::string& b) {
+  std::error_code ec;
+  return fs::equivalent(a, b, ec) && !ec;
+}
+
+int commandRun(std::string sceneArg, const std::vector<std::string>& sets, std::string out, bool overwrite,
+               const std::string& restart) {
   const double t0 = mfsi::wallSeconds();
+  mfsi::installInterruptHandlers();
+  // --restart: the checkpoint, the folder of the run that wrote it (the default --out: the run
+  // continues its files there) and its scene (the default scene).
+  std::string checkpoint;
+  bool continueFiles = false;
+  if (!restart.empty()) {
+    try {
+      checkpoint = mfsi::Simulation::findCheckpoint(restart);
+    } catch (const mfsi::InputError& e) {
+      std::cerr << "error: " << e.what() << "\n";
+      return 2;
+    }
+    const std::string runFolder = mfsi::Simulation::runFolderOf(checkpoint);
+    if (out.empty()) out = runFolder;
+    if (sceneArg.empty()) sceneArg = (fs::path(runFolder) / "scene.yaml").string();
+    continueFiles = sameFolder(out, runFolder);
+  }
+  if (sceneArg.empty()) sceneArg = kDefaultScene;
   mfsi::RunSummary summary;
   summary.scene = sceneArg;
   summary.backend = mfsi::backendName();
@@ -145,10 +175,11 @@ int commandRun(const std::string& sceneArg, const std::vector<std::string>& sets
   int rank = 0;
   MPI_Comm_rank(MPI_COMM_WORLD, &rank);
   int code = 0;
+  bool started = false;  ///< the run has begun writing into `out`
   std::unique_ptr<mfsi::Simulation> sim;
   if (out.empty()) out = (fs::path("results") / fs::path(sceneArg).stem()).string();
   try {
-    if (rank == 0) prepareOutput(out, overwrite);
+    if (rank == 0 && !continueFiles) prepareOutput(out, overwrite);
   } catch (const mfsi::InputError& e) {
     std::cerr << "error: " << e.what() << "\n";  // no summary: the folder is not ours to write
     return 2;
@@ -169,16 +200,32 @@ int commandRun(const std::string& sceneArg, const std::vector<std::string>& sets
       summary.cells = sim->mesh().nCells();
       summary.nodes = sim->mesh().nNodes();
     }
+    if (!checkpoint.empty()) {
+      sim->restore(checkpoint);
+      if (rank == 0)
+        std::cout << "continuing from " << checkpoint << " (step " << sim->completedSteps() << ", t = "
+                  << sim->completedTime() << ")\n";
+    }
+    started = true;
     mfsi::writeTextAtomically(out + "/scene.yaml", resolved);
-    const auto result = sim->run(out, rank == 0 && mfsi::stdoutIsTerminal());
+    const auto result = sim->run(out, rank == 0 && mfsi::stdoutIsTerminal(), continueFiles);
     summary.steps = result.steps;
     summary.simTime = result.simTime;
     summary.metrics = result.metrics;
+    if (result.interruptedBy != 0) {
+      summary.status = "interrupted";
+      summary.error = std::string("stopped by ") + mfsi::signalName(result.interruptedBy) + " after step " +
+                      std::to_string(result.steps) + "; continue with: mfsi run --restart " + out;
+      std::cerr << "interrupted: " << summary.error << " (checkpoint " << result.lastCheckpoint << ")\n";
+      code = 128 + result.interruptedBy;
+    }
   } catch (const mfsi::InputError& e) {
     summary.status = "error";
     summary.error = e.what();
     std::cerr << "error: " << e.what() << "\n";
     code = 2;
+    // A restart that cannot continue leaves the folder of the run it was to continue untouched.
+    if (continueFiles && !started) return code;
   } catch (const mfsi::DivergenceError& e) {
     summary.status = "diverged";
     summary.error = e.what();
@@ -204,7 +251,7 @@ int commandRun(const std::string& sceneArg, const std::vector<std::string>& sets
   if (rank == 0) {
     try {
       mfsi::writeSummary(out, summary);
-      std::cout << (code == 0 ? "done" : "failed") << " in " << summary.wallSeconds << " s; results in " << out
+      std::cout << (code == 0 ? "done" : summary.status == "interrupted" ? "interrupted" : "failed") << " in " << summary.wallSeconds << " s; results in " << out
                 << "/ (summary.json)\n";
     } catch (const std::exception& e) {
       std::cerr << "error: cannot write the summary: " << e.what() << "\n";
@@ -221,7 +268,7 @@ int main(int argc, char** argv) {
   app.set_version_flag("--version", std::string("mfsi ") + MFSI_VERSION);
   app.require_subcommand(1);
 
-  std::string scene = kDefaultScene, out;
+  std::string scene, out, restart;
   std::vector<std::string> sets;
   int threads = 0;
   bool describe = false;
@@ -232,6 +279,9 @@ int main(int argc, char** argv) {
   run->add_option("--set", sets, "override a scene value: --set a.b.c=value (repeatable)");
   run->add_option("--out", out, "output folder (default: results/<scene>)");
   run->add_flag("--overwrite", overwrite, "replace the results of an earlier run in the output folder");
+  run->add_option("--restart", restart,
+                  "continue a run from a checkpoint: its folder (the latest checkpoint in it) or a checkpoint "
+                  "file; the scene defaults to the run's scene.yaml and --out to its folder (continuing its files)");
   run->add_option("--threads", threads, "host threads (default: OMP_NUM_THREADS or all cores)")->check(CLI::PositiveNumber);
 
   auto* check = app.add_subcommand("check", "validate a scene without running it");
@@ -240,6 +290,11 @@ int main(int argc, char** argv) {
   check->add_flag("--describe", describe, "list every scene key with type, default, units and doc");
 
   app.add_subcommand("scenes", "list the built-in scenes");
+
+  std::string plotDir, plotOut;
+  auto* plot = app.add_subcommand("plot", "PNGs of a run folder's time series (and, for a 2D scene, its last field)");
+  plot->add_option("run_dir", plotDir, "a folder written by `mfsi run`")->required();
+  plot->add_option("--out", plotOut, "folder for the PNGs (default: RUN_DIR/plots)");
 
   try {
     app.parse(argc, argv);
@@ -265,9 +320,11 @@ int main(int argc, char** argv) {
     int kargc = static_cast<int>(kargv.size());
     Kokkos::ScopeGuard kokkos(kargc, kargv.data());
     if (app.got_subcommand("run")) {
-      code = commandRun(scene, sets, out, overwrite);
+      code = commandRun(scene, sets, out, overwrite, restart);
+    } else if (app.got_subcommand("plot")) {
+      code = commandPlot(plotDir, plotOut);
     } else if (app.got_subcommand("check")) {
-      code = commandCheck(scene, sets, describe);
+      code = commandCheck(scene.empty() ? kDefaultScene : scene, sets, describe);
     } else {
       code = commandScenes();
     }

@@ -15,7 +15,7 @@ namespace mfsi {
 ///  "timers":{phase: s},"metrics":{name: number}}.
 struct RunSummary {
   std::string scene;
-  std::string status = "ok";  ///< "ok" | "diverged" | "error"
+  std::string status = "ok";  ///< "ok" | "diverged" | "error" | "interrupted"
   std::string error;          ///< empty -> null
   double wallSeconds = 0.0;
   long long steps = 0;

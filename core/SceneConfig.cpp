@@ -9,6 +9,7 @@
 #include <filesystem>
 #include <fstream>
 #include <functional>
+#include <map>
 #include <sstream>
 #include <stdexcept>
 
@@ -346,6 +347,37 @@ void SceneConfig::read(const std::string& path, std::vector<std::string>& v) con
 void SceneConfig::checkLength(const std::string& path, std::size_t n, std::size_t wanted) const {
   if (n != wanted)
     programmerError(full(path), "has " + std::to_string(n) + " items, read as an array of " + std::to_string(wanted));
+}
+
+namespace {
+void flatten(const YAML::Node& n, const std::string& key, std::map<std::string, std::string>& out) {
+  if (n.IsMap()) {
+    for (const auto& kv : n) flatten(kv.second, key.empty() ? kv.first.as<std::string>() : key + "." + kv.first.as<std::string>(), out);
+  } else if (n.IsSequence()) {
+    for (std::size_t i = 0; i < n.size(); ++i) flatten(n[i], key + "." + std::to_string(i), out);
+  } else {
+    out[key] = n.IsNull() ? "null" : n.as<std::string>();
+  }
+}
+}  // namespace
+
+std::vector<std::string> sceneDifferences(const std::string& before, const std::string& after) {
+  std::map<std::string, std::string> a, b;
+  flatten(YAML::Load(before), "", a);
+  flatten(YAML::Load(after), "", b);
+  std::vector<std::string> out;
+  auto value = [](const std::map<std::string, std::string>& m, const std::string& k) {
+    const auto it = m.find(k);
+    return it == m.end() ? std::string("(none)") : it->second;
+  };
+  std::map<std::string, bool> keys;
+  for (const auto& kv : a) keys[kv.first] = true;
+  for (const auto& kv : b) keys[kv.first] = true;
+  for (const auto& kv : keys) {
+    const std::string va = value(a, kv.first), vb = value(b, kv.first);
+    if (va != vb) out.push_back(kv.first + ": " + va + " -> " + vb);
+  }
+  return out;
 }
 
 }  // namespace mfsi

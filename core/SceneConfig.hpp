@@ -110,4 +110,8 @@ class SceneConfig {
   std::string prefix_;
 };
 
+/// \brief The keys whose values differ between two resolved scenes (YAML text), each as
+/// "key: before -> after" ("(none)" for a key one of them lacks), in key order.
+std::vector<std::string> sceneDifferences(const std::string& before, const std::string& after);
+
 }  // namespace mfsi

@@ -193,12 +193,36 @@ ModuleEntry fluidModuleEntry() {
           }};
 }
 
-void FluidModule::saveState(io::StateWriter& /*w*/) const {
-  throw InputError(name() + ": checkpoints are not available for this module yet");
+void FluidModule::saveState(io::StateWriter& w) const {
+  io::StateWriter s = w.sub("solver");
+  solver_.saveState(s);
+  const fluid::StepResult& l = last_;
+  w.put("lastStep", std::vector<double>{double(l.ok), double(l.converged), double(l.outerIterations),
+                                        double(l.momentumIterations), double(l.pressureIterations), l.momentumResidual,
+                                        l.pressureResidual, l.finalMomentumResidual, l.finalPressureResidual,
+                                        l.continuityMax, l.continuitySum});
+  w.put("totals", std::vector<std::int64_t>{outerTotal_, pressureTotal_, momentumTotal_});
 }
 
-void FluidModule::loadState(const io::StateReader& /*r*/) {
-  throw InputError(name() + ": restart is not available for this module yet");
+void FluidModule::loadState(const io::StateReader& r) {
+  solver_.loadState(r.sub("solver"));
+  const auto v = r.doubles("lastStep", 11);
+  fluid::StepResult& l = last_;
+  l.ok = v[0] != 0;
+  l.converged = v[1] != 0;
+  l.outerIterations = static_cast<int>(v[2]);
+  l.momentumIterations = static_cast<int>(v[3]);
+  l.pressureIterations = static_cast<int>(v[4]);
+  l.momentumResidual = v[5];
+  l.pressureResidual = v[6];
+  l.finalMomentumResidual = v[7];
+  l.finalPressureResidual = v[8];
+  l.continuityMax = v[9];
+  l.continuitySum = v[10];
+  const auto t = r.ints("totals", 3);
+  outerTotal_ = t[0];
+  pressureTotal_ = t[1];
+  momentumTotal_ = t[2];
 }
 
 }  // namespace mfsi

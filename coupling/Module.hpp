@@ -37,6 +37,9 @@ struct SimulationContext {
 struct OutputStart {
   long long step = 0;
   bool continueFiles = false;
+  /// The step the folder's files begin after (0, or the step of the checkpoint a run was
+  /// restarted from into a new folder): a continued file keeps its rows of steps firstStep+1 .. step.
+  long long firstStep = 0;
 };
 
 class Module {

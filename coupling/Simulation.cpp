@@ -1,11 +1,17 @@
 #include "coupling/Simulation.hpp"
 
+#include "core/Interrupt.hpp"
 #include "core/MeshConfig.hpp"
 #include "core/io/HostCopy.hpp"
 
 #include <cmath>
+#include <cstdio>
+#include <cstring>
+#include <filesystem>
 
 namespace mfsi {
+
+namespace fs = std::filesystem;
 
 namespace {
 /// Steps a scene may ask for: a billion-step run of the smallest scene takes weeks.
@@ -33,6 +39,16 @@ Schema sceneSchema() {
                              Default(0))
                         .key("initial", Schema::boolean("a frame of the state at the start"), Default(false))
                         .key("final", Schema::boolean("a frame of the state at the end of the run"), Default(true)),
+                    Presence::Optional)
+               .key("checkpoint",
+                    Schema::map("checkpoints to continue the run from (mfsi run --restart RUN_DIR): "
+                                "checkpoints/checkpoint_<step>.h5; SIGINT and SIGTERM always write one")
+                        .key("everySteps", Schema::integer("a checkpoint every this many steps (0: not by steps)")
+                                               .atLeast(0), Default(0))
+                        .key("wallSeconds", Schema::real("a checkpoint every this much wall-clock time (0: not by "
+                                                         "time)", "s").atLeast(0), Default(0.0))
+                        .key("keep", Schema::integer("the most recent checkpoints kept").atLeast(1), Default(2))
+                        .key("final", Schema::boolean("a checkpoint at the end of the run"), Default(false)),
                     Presence::Optional),
            Presence::Optional);
   for (const auto& entry : moduleCatalogue()) s.key(entry.section, entry.schema(), Presence::OptionalSection);
@@ -55,6 +71,11 @@ Simulation::Simulation(const SceneConfig& scene) {
   fieldOutput_.everySteps = scene.get<int>("output.fields.everySteps");
   fieldOutput_.initial = scene.get<bool>("output.fields.initial");
   fieldOutput_.final = scene.get<bool>("output.fields.final");
+  checkpoint_.everySteps = scene.get<int>("output.checkpoint.everySteps");
+  checkpoint_.wallSeconds = scene.get<double>("output.checkpoint.wallSeconds");
+  checkpoint_.keep = scene.get<int>("output.checkpoint.keep");
+  checkpoint_.final = scene.get<bool>("output.checkpoint.final");
+  sceneText_ = scene.resolvedYaml(false);
   if (time_.endTime > 0 && time_.dt <= 0)
     throw InputError(scene.where("time.dt"), "a positive time step is needed when time.endTime > 0");
   if (time_.endTime > 0) {
@@ -135,30 +156,48 @@ io::FieldFrame Simulation::fieldFrame(double time, long long step) {
   return frame;
 }
 
-RunResult Simulation::run(const std::string& outDir, bool terminal) {
+RunResult Simulation::run(const std::string& outDir, bool terminal, bool continueFiles) {
   RunResult r;
   const long long nSteps = nSteps_;
+  continueFiles = continueFiles && start_.restored;
+  TimeState ts;
+  if (start_.restored) ts = start_.time;
+  ts.endTime = time_.endTime;
+  firstStep_ = continueFiles ? start_.firstStep : ts.step;
   std::vector<std::string> columns = {"step", "time", "wall_s"};
   for (const Module* m : reporting_)
     for (const auto& c : m->stepColumns()) columns.push_back(m->name() + "." + c);
-  StepLog log(outDir + "/steps.csv", columns);
-  for (Module* m : reporting_) m->openOutput(outDir, OutputStart{});
+  StepLog log = continueFiles ? StepLog(outDir + "/steps.csv", columns, ts.step - firstStep_)
+                              : StepLog(outDir + "/steps.csv", columns);
+  const OutputStart outputStart{ts.step, continueFiles, firstStep_};
+  for (Module* m : reporting_) m->openOutput(outDir, outputStart);
   Progress progress(nSteps, time_.endTime, terminal);
-  TimeState ts;
-  ts.endTime = time_.endTime;
   io::FieldSeries fields(outDir);
-  long long lastFrameStep = -1;
+  if (continueFiles) fields.restore(start_.fields, ts.step);
+  long long lastFrameStep = start_.restored ? start_.lastFrameStep : -1;
   auto writeFrame = [&] {
     ScopedTimer t(timers_, "output");
     fields.write(fieldFrame(ts.time, ts.step));
     lastFrameStep = ts.step;
   };
-  double nextFrameTime = fieldOutput_.interval;
-  if (fieldOutput_.initial) writeFrame();
-  const double start = wallSeconds();
-  for (long long s = 0; s < nSteps; ++s) {
+  double nextFrameTime = start_.restored ? start_.nextFrameTime : fieldOutput_.interval;
+  if (fieldOutput_.initial && !start_.restored) writeFrame();
+  // wall_s and checkpoints count the wall time of the steps before a restart too.
+  const double start = wallSeconds() - start_.wallSeconds;
+  double lastCheckpointWall = wallSeconds();
+  long long lastCheckpointStep = start_.restored ? ts.step : -1;
+  auto checkpoint = [&] {
+    ScopedTimer t(timers_, "checkpoint");
+    r.lastCheckpoint = writeCheckpoint(outDir, ts, fields, nextFrameTime, lastFrameStep, wallSeconds() - start);
+    lastCheckpointWall = wallSeconds();
+    lastCheckpointStep = ts.step;
+  };
+  for (long long s = ts.step; s < nSteps; ++s) {
     ts.dtOld = ts.step > 0 ? ts.dt : time_.dt;
-    ts.dt = std::min(time_.dt, time_.endTime - ts.time);
+    // The last step ends at endTime; a remainder short of dt by round-off alone (time summed
+    // step by step) is a full step, not a step of 0.0199999... that a variable-step scheme would see.
+    const double rest = time_.endTime - ts.time;
+    ts.dt = rest < time_.dt * (1 - 1e-9) ? rest : time_.dt;
     {
       ScopedTimer t(timers_, "advance");
       for (auto& m : modules_) m->advance(ts);
@@ -177,8 +216,16 @@ RunResult Simulation::run(const std::string& outDir, bool terminal) {
     }
     if (frame) writeFrame();
     progress.update(ts.step, ts.time);
+    if (interruptSignal() != 0) {
+      r.interruptedBy = interruptSignal();
+      break;
+    }
+    const bool byStep = checkpoint_.everySteps > 0 && ts.step % checkpoint_.everySteps == 0;
+    const bool byWall = checkpoint_.wallSeconds > 0 && wallSeconds() - lastCheckpointWall >= checkpoint_.wallSeconds;
+    if (byStep || byWall) checkpoint();
   }
-  if (fieldOutput_.final && lastFrameStep != ts.step) writeFrame();
+  if ((r.interruptedBy != 0 || checkpoint_.final) && lastCheckpointStep != ts.step) checkpoint();
+  if (fieldOutput_.final && lastFrameStep != ts.step && r.interruptedBy == 0) writeFrame();
   progress.finish();
   r.steps = ts.step;
   r.simTime = ts.time;
@@ -189,6 +236,141 @@ RunResult Simulation::run(const std::string& outDir, bool terminal) {
     for (const Module* m : reporting_) m->addMetrics(r.metrics);
   }
   return r;
+}
+
+namespace {
+
+constexpr const char* kCheckpointPrefix = "checkpoint_";
+
+/// The step of a checkpoint file name, or -1 for another file.
+long long checkpointStep(const fs::path& file) {
+  const std::string n = file.filename().string();
+  const std::size_t p = std::strlen(kCheckpointPrefix);
+  if (n.size() <= p + 3 || n.compare(0, p, kCheckpointPrefix) != 0 || file.extension() != ".h5") return -1;
+  const std::string digits = n.substr(p, n.size() - p - 3);
+  if (digits.empty() || digits.size() > 15 || digits.find_first_not_of("0123456789") != std::string::npos) return -1;
+  return std::stoll(digits);
+}
+
+/// The checkpoint files of a folder by step.
+std::map<long long, fs::path> checkpointFiles(const fs::path& dir) {
+  std::map<long long, fs::path> files;
+  std::error_code ec;
+  if (!fs::is_directory(dir, ec)) return files;
+  for (const auto& e : fs::directory_iterator(dir, ec)) {
+    const long long step = checkpointStep(e.path());
+    if (step >= 0) files[step] = e.path();
+  }
+  return files;
+}
+
+/// Scene keys a restart may change: when it ends and what it writes, not what it computes.
+bool restartMayChange(const std::string& difference) {
+  for (const char* key : {"time.endTime:", "time.maxSteps:", "name:", "description:"})
+    if (difference.rfind(key, 0) == 0) return true;
+  return difference.rfind("output.", 0) == 0;
+}
+
+}  // namespace
+
+std::string Simulation::writeCheckpoint(const std::string& outDir, const TimeState& ts, const io::FieldSeries& fields,
+                                        double nextFrameTime, long long lastFrameStep, double wall) const {
+  const fs::path dir = fs::path(outDir) / "checkpoints";
+  std::error_code ec;
+  fs::create_directories(dir, ec);
+  if (ec) throw OutputError("cannot create '" + dir.string() + "': " + ec.message());
+  char name[64];
+  std::snprintf(name, sizeof name, "%s%09lld.h5", kCheckpointPrefix, static_cast<long long>(ts.step));
+  const std::string path = (dir / name).string();
+  io::Hdf5File file = io::Hdf5File::create(path);
+  io::StateWriter run(file, "/run");
+  run.putText("version", MFSI_VERSION);
+  run.putText("scene", sceneText_);
+  run.putInt("step", ts.step);
+  run.put("time", std::vector<double>{ts.time, ts.dt, ts.dtOld, nextFrameTime, wall});
+  run.putInt("lastFrameStep", lastFrameStep);
+  run.putInt("firstStep", firstStep_);
+  run.putText("fields", fields.state());
+  if (hasMesh_) {
+    io::StateWriter mesh(file, "/mesh");
+    mesh.putView("points", mesh_.points());
+  }
+  for (const Module* m : reporting_) {
+    io::StateWriter w(file, "/modules/" + m->name());
+    m->saveState(w);
+  }
+  file.commit();
+  // The most recent `keep` stay.
+  const auto files = checkpointFiles(dir);
+  long long excess = static_cast<long long>(files.size()) - checkpoint_.keep;
+  for (const auto& [step, f] : files) {
+    if (excess-- <= 0) break;
+    fs::remove(f, ec);
+  }
+  return path;
+}
+
+std::string Simulation::findCheckpoint(const std::string& path) {
+  std::error_code ec;
+  if (fs::is_regular_file(path, ec)) return path;
+  if (!fs::is_directory(path, ec))
+    throw InputError("--restart '" + path + "': no such run folder or checkpoint file");
+  const auto files = checkpointFiles(fs::path(path) / "checkpoints");
+  if (files.empty())
+    throw InputError("--restart '" + path + "': no checkpoint in '" + (fs::path(path) / "checkpoints").string() +
+                     "' (a run writes them as output.checkpoint asks, and when SIGINT or SIGTERM stops it)");
+  return files.rbegin()->second.string();
+}
+
+std::string Simulation::runFolderOf(const std::string& checkpointFile) {
+  const fs::path dir = fs::absolute(checkpointFile).parent_path();
+  return (dir.filename() == "checkpoints" ? dir.parent_path() : dir).string();
+}
+
+void Simulation::restore(const std::string& checkpointFile) {
+  io::Hdf5File file = [&] {
+    try {
+      return io::Hdf5File::openRead(checkpointFile);
+    } catch (const OutputError& e) {
+      throw InputError(std::string("--restart: ") + e.what());
+    }
+  }();
+  const io::StateReader run(file, "/run");
+  const std::string before = run.text("scene");
+  std::string refused;
+  for (const std::string& d : sceneDifferences(before, sceneText_))
+    if (!restartMayChange(d)) refused += "\n  " + d;
+  if (!refused.empty())
+    throw InputError("--restart: the scene differs from the one that wrote '" + checkpointFile +
+                     "' in what the run computes (only time.endTime, time.maxSteps and output may change):" + refused);
+  StartState& st = start_;
+  st.time.step = static_cast<int>(run.integer("step"));
+  const auto tv = run.doubles("time", 5);
+  st.time.time = tv[0];
+  st.time.dt = tv[1];
+  st.time.dtOld = tv[2];
+  st.nextFrameTime = tv[3];
+  st.wallSeconds = tv[4];
+  st.lastFrameStep = run.integer("lastFrameStep");
+  st.firstStep = run.integer("firstStep");
+  st.fields = run.text("fields");
+  if (st.time.step > nSteps_)
+    throw InputError("--restart: the checkpoint is at step " + std::to_string(st.time.step) + " (t = " +
+                     formatReal(st.time.time) + "), beyond the scene's end (" + std::to_string(nSteps_) +
+                     " steps): raise time.endTime to continue");
+  if (hasMesh_) {
+    io::StateReader mesh(file, "/mesh");
+    mesh.getView("points", mesh_.points());
+  }
+  // Parts first, then the module that owns them (the coupling places its mounted membranes by
+  // the bodies' state).
+  for (auto& m : modules_) {
+    for (Module* p : m->parts()) p->loadState(io::StateReader(file, "/modules/" + p->name()));
+    m->loadState(io::StateReader(file, "/modules/" + m->name()));
+  }
+  st.restored = true;
+  completedSteps_ = st.time.step;
+  completedTime_ = st.time.time;
 }
 
 }  // namespace mfsi

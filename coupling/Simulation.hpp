@@ -24,11 +24,22 @@ struct FieldOutputOptions {
   bool final = true;     ///< a frame of the end state
 };
 
+/// \brief When checkpoints are written (`output.checkpoint`).
+struct CheckpointOptions {
+  int everySteps = 0;       ///< a checkpoint every this many steps (0: not by steps)
+  double wallSeconds = 0;   ///< a checkpoint every this much wall-clock time (0: not by time)
+  int keep = 2;             ///< the most recent checkpoints kept (older ones are removed)
+  bool final = false;       ///< a checkpoint at the end of the run
+};
+
 /// \brief What `Simulation::run` reports back.
 struct RunResult {
   long long steps = 0;
   double simTime = 0.0;
   std::map<std::string, double> metrics;
+  /// SIGINT or SIGTERM stopped the run after `steps` (a checkpoint of that state was written).
+  int interruptedBy = 0;
+  std::string lastCheckpoint;  ///< path of the last checkpoint written ("" if none)
 };
 
 class Simulation {
@@ -36,8 +47,22 @@ class Simulation {
   /// Build the mesh and the modules the scene names. Throws InputError on bad input.
   explicit Simulation(const SceneConfig& scene);
 
-  /// Step to the end time, writing steps.csv into `outDir` and drawing progress.
-  RunResult run(const std::string& outDir, bool terminal);
+  /// Step to the end time, writing steps.csv into `outDir` and drawing progress. After `restore`,
+  /// from the checkpoint's step on; `continueFiles`: into the folder of the run that wrote the
+  /// checkpoint, continuing its steps.csv, module files and field index (else new files).
+  /// SIGINT/SIGTERM (installInterruptHandlers) end the run after the current step with a
+  /// checkpoint (RunResult::interruptedBy).
+  RunResult run(const std::string& outDir, bool terminal, bool continueFiles = false);
+
+  /// Put the run into the state a checkpoint holds, bitwise. The scene may differ from the one
+  /// that wrote the checkpoint in time.endTime, time.maxSteps, output, name and description
+  /// alone; anything else is refused with the list of changes. Throws InputError.
+  void restore(const std::string& checkpointFile);
+  /// The checkpoint to continue a run from: `path` itself (a file), or the latest checkpoint in
+  /// `<path>/checkpoints/`. Throws InputError when there is none.
+  static std::string findCheckpoint(const std::string& path);
+  /// The run folder a checkpoint file belongs to (the parent of its `checkpoints/` folder).
+  static std::string runFolderOf(const std::string& checkpointFile);
 
   /// True when the scene has a `mesh` section (a rigid-only or membrane-only scene has none).
   bool hasMesh() const { return hasMesh_; }
@@ -52,6 +77,9 @@ class Simulation {
 
  private:
   void meshMetrics(std::map<std::string, double>& m) const;
+  /// Write `<outDir>/checkpoints/checkpoint_<step>.h5` and remove the ones beyond `keep`.
+  std::string writeCheckpoint(const std::string& outDir, const TimeState& ts, const io::FieldSeries& fields,
+                              double nextFrameTime, long long lastFrameStep, double wallSeconds) const;
   /// The state now, as one output frame: the scene mesh's grid "mesh" (positions, displacement
   /// from the reference mesh, each cell's scaled Jacobian) and every module's fields.
   io::FieldFrame fieldFrame(double time, long long step);
@@ -63,6 +91,20 @@ class Simulation {
   TimeOptions time_;
   long long nSteps_ = 0;  ///< from time_ (checked at set-up)
   FieldOutputOptions fieldOutput_;
+  CheckpointOptions checkpoint_;
+  std::string sceneText_;  ///< the resolved scene, kept in checkpoints to compare on restart
+  /// Where a restored run starts (restore()).
+  struct StartState {
+    bool restored = false;
+    TimeState time;
+    double nextFrameTime = 0;
+    long long lastFrameStep = -1;
+    std::string fields;   ///< FieldSeries::state() of the run that wrote the checkpoint
+    double wallSeconds = 0;  ///< wall time of the steps before the checkpoint
+    long long firstStep = 0;  ///< OutputStart::firstStep of the run that wrote it
+  };
+  StartState start_;
+  long long firstStep_ = 0;  ///< OutputStart::firstStep of this run's files
   std::vector<std::unique_ptr<Module>> modules_;  ///< advanced by the driver
   std::vector<Module*> reporting_;                ///< modules_ and their parts: output, columns, metrics
   long long completedSteps_ = 0;

@@ -271,4 +271,28 @@ void BoundaryConditions::setWallVelocity(const std::string& name, const ConstRea
   }
 }
 
+void BoundaryConditions::saveState(io::StateWriter& w) const {
+  w.putReal("time", time_);
+  w.putView("velocity", velocity_);
+  w.putView("pressure", pressure_);
+  w.putView("external", external_);
+  std::vector<double> patchValues;
+  for (const ResolvedPatch& rp : patches_) patchValues.insert(patchValues.end(), {rp.currentPressure, rp.currentFlowRate});
+  w.put("patchPressureAndFlowRate", patchValues);
+}
+
+void BoundaryConditions::loadState(const io::StateReader& r) {
+  time_ = r.real("time");
+  r.getView("velocity", velocity_);
+  r.getView("pressure", pressure_);
+  r.getView("external", external_);
+  Kokkos::deep_copy(hVelocity_, velocity_);
+  Kokkos::deep_copy(hPressure_, pressure_);
+  const auto patchValues = r.doubles("patchPressureAndFlowRate", 2 * static_cast<long long>(patches_.size()));
+  for (std::size_t i = 0; i < patches_.size(); ++i) {
+    patches_[i].currentPressure = patchValues[2 * i];
+    patches_[i].currentFlowRate = patchValues[2 * i + 1];
+  }
+}
+
 }  // namespace mfsi::fluid

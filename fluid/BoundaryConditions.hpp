@@ -2,6 +2,7 @@
 /// \file
 /// \brief Fluid boundary conditions: resolves the per-patch options against the mesh patches and
 /// keeps the per-face prescribed values (velocity, pressure) on the device.
+#include "core/io/Checkpoint.hpp"
 #include "core/MeshGeometry.hpp"
 #include "fluid/FluidOptions.hpp"
 
@@ -62,6 +63,10 @@ class BoundaryConditions {
   const std::vector<ResolvedPatch>& patches() const { return patches_; }
   /// Indices (into patches()) of the patches that `name` designates: a patch, or both baffle sides.
   std::vector<int> find(const std::string& name) const;
+  /// The values a later step reads (face values, external wall velocities, each patch's last
+  /// pressure and flow rate), for a checkpoint.
+  void saveState(io::StateWriter& w) const;
+  void loadState(const io::StateReader& r);
 
  private:
   const HexMesh* mesh_ = nullptr;

@@ -5,6 +5,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <iterator>
 #include <string>
 #include <utility>
 
@@ -462,6 +463,108 @@ void FluidSolver::beginStep(real t, real dt) {
   if (bc_.fixesPressureLevel()) gradPValid_ = false;
   updateBoundaryVelocity();
   if (stepStart_.enabled) takeStepStart();
+}
+
+void FluidSolver::saveState(io::StateWriter& w) const {
+  exec_.fence();
+  // Fields a step reads before it writes them; the scratch of an outer iteration (HbyA, the
+  // right-hand sides, the face coefficients and fluxes of one corrector) is not kept.
+  w.putView("U", U_);
+  w.putView("U0", U0_);
+  w.putView("U00", U00_);
+  w.putView("p", p_);
+  w.putView("pPrevIter", pPrev_);
+  w.putView("p0", p0_);
+  w.putView("p00", p00_);
+  w.putView("V0", V0_);
+  w.putView("V00", V00_);
+  w.putView("gradP", gradP_);
+  w.putView("rAU", rAU_);
+  w.putBool("gradUCurrent", gradUCurrent_);
+  if (gradUCurrent_) w.putView("gradU", gradU_);
+  w.putView("phi", phi_);
+  w.putView("meshPhi", meshPhi_);
+  w.putView("dphi", dphi_);
+  w.putView("dphi0", dphi0_);
+  w.putView("dphi00", dphi00_);
+  w.putView("sweptNew", sweptNew_);
+  w.putView("sweptOld", sweptOld_);
+  w.putView("Ub", Ub_);
+  w.putView("faceMeshVelocity", faceMeshVel_);
+  w.putView("pb", pb_);
+  w.putView("points0", points0_);
+  w.putView("dpFinal", dpFinal_);
+  w.putView("pressureMatrix", Ap_.values);
+  w.put("time", std::vector<double>{t_, dt_, dt0_, c1_, c0_, c00_});
+  w.putInt("steps", nSteps_);
+  w.putInt("pressureAssemblies", pressureAssemblies_);
+  w.putInt("refreshBaselineIterations", refreshBaselineIterations_);
+  const bool flags[] = {pressureRefreshDue_, bdf2Active_, gradPValid_, sweptNewZero_, sweptOldZero_, meshStatic_,
+                        meshMoved_, freshStep_, dpFinalValid_, meshFluxZero_, dphiLatest_};
+  std::vector<std::int64_t> f;
+  for (bool b : flags) f.push_back(b ? 1 : 0);
+  w.put("flags", f);
+  io::StateWriter bc = w.sub("boundaryConditions");
+  bc_.saveState(bc);
+  io::StateWriter pp = w.sub("pressurePreconditioner");
+  linear_.savePressurePreconditioner(pp);
+}
+
+void FluidSolver::loadState(const io::StateReader& r) {
+  // The geometry of the points the mesh is at now (restored by the caller), as moveMesh made it.
+  updateGeometry();
+  r.getView("U", U_);
+  r.getView("U0", U0_);
+  r.getView("U00", U00_);
+  r.getView("p", p_);
+  r.getView("pPrevIter", pPrev_);
+  r.getView("p0", p0_);
+  r.getView("p00", p00_);
+  r.getView("V0", V0_);
+  r.getView("V00", V00_);
+  r.getView("gradP", gradP_);
+  r.getView("rAU", rAU_);
+  gradUCurrent_ = r.boolean("gradUCurrent");
+  if (gradUCurrent_) r.getView("gradU", gradU_);
+  r.getView("phi", phi_);
+  r.getView("meshPhi", meshPhi_);
+  r.getView("dphi", dphi_);
+  r.getView("dphi0", dphi0_);
+  r.getView("dphi00", dphi00_);
+  r.getView("sweptNew", sweptNew_);
+  r.getView("sweptOld", sweptOld_);
+  r.getView("Ub", Ub_);
+  r.getView("faceMeshVelocity", faceMeshVel_);
+  r.getView("pb", pb_);
+  r.getView("points0", points0_);
+  const auto dpShape = r.shape("dpFinal");
+  if (!dpShape.empty() && dpShape[0] > 0 && dpFinal_.extent(0) == 0) {  // as startFinalPressureSolve allocates them
+    dpFinal_ = RealView("mfsi::fluid::pressure::finalChange", nCells_);
+    pFinalStart_ =
+        RealView(Kokkos::view_alloc(Kokkos::WithoutInitializing, "mfsi::fluid::pressure::finalStart"), nCells_);
+  }
+  r.getView("dpFinal", dpFinal_);
+  const auto tv = r.doubles("time", 6);
+  t_ = tv[0];
+  dt_ = tv[1];
+  dt0_ = tv[2];
+  c1_ = tv[3];
+  c0_ = tv[4];
+  c00_ = tv[5];
+  nSteps_ = static_cast<int>(r.integer("steps"));
+  pressureAssemblies_ = static_cast<long>(r.integer("pressureAssemblies"));
+  refreshBaselineIterations_ = static_cast<int>(r.integer("refreshBaselineIterations"));
+  bool* flags[] = {&pressureRefreshDue_, &bdf2Active_, &gradPValid_, &sweptNewZero_, &sweptOldZero_, &meshStatic_,
+                   &meshMoved_, &freshStep_, &dpFinalValid_, &meshFluxZero_, &dphiLatest_};
+  const auto f = r.ints("flags", static_cast<long long>(std::size(flags)));
+  for (std::size_t i = 0; i < f.size(); ++i) *flags[i] = f[i] != 0;
+  bc_.loadState(r.sub("boundaryConditions"));
+  // The preconditioner's replay writes Ap_'s values: they are read back after it.
+  pressureLattice_ = nullptr;
+  linear_.loadPressurePreconditioner(r.sub("pressurePreconditioner"), exec_, Ap_);
+  r.getView("pressureMatrix", Ap_.values);
+  stepStart_.valid = false;
+  exec_.fence();
 }
 
 namespace {

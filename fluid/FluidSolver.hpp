@@ -92,6 +92,14 @@ class FluidSolver {
   /// current step (`keepStepStart(true)` before its `beginStep`); the mesh stays where it is.
   void restoreStepStart();
 
+  // --- checkpoints ---------------------------------------------------------------------------
+  /// \brief Write everything the next step reads (fields, old time levels, guesses, the pressure
+  /// preconditioner's history, boundary values and the solver's counters), between steps.
+  void saveState(io::StateWriter& w) const;
+  /// \brief Read what saveState wrote, into a solver built from the same options on the same mesh
+  /// whose points are already where they were when it was saved: the run then continues bitwise.
+  void loadState(const io::StateReader& r);
+
   // --- boundary input ------------------------------------------------------------------------
   /// \brief Per-face wall velocity for a wall patch with `WallMotion::External`, or for both sides
   /// of a baffle when `name` is the baffle name (size: faces of one side). The normal component

@@ -77,11 +77,54 @@ void LinearSolver::momentumMatrixChanged(const ExecSpace& exec, const CsrMatrix&
 void LinearSolver::pressureMatrixChanged(const ExecSpace& exec, const CsrMatrix& A) {
   // Values assembled into CG's lattice only: the preconditioner reads A's CSR values.
   if (pSolver_->lattice().assembledFor(A)) pSolver_->lattice().writeCsr(exec, A);
+  auto* amg = dynamic_cast<AmgPreconditioner*>(pPrec_.get());
   if (pReady_)
     pPrec_->updateValues(exec, A);
   else
     pPrec_->setup(exec, A);
+  // Remember what it was built from (see PressurePreconditionerHistory).
+  PressurePreconditionerHistory& h = pHistory_;
+  RealView& keep = pReady_ ? h.refreshValues : h.setupValues;
+  if (keep.extent(0) != A.values.extent(0)) keep = RealView("mfsi::fluid::pressure::preconditionerValues", A.values.extent(0));
+  Kokkos::deep_copy(exec, keep, A.values);
+  (pReady_ ? h.refreshSweeps : h.setupSweeps) = amg ? amg->finestSweeps() : 0;
+  h.refreshed = pReady_;
   pReady_ = true;
+}
+
+void LinearSolver::savePressurePreconditioner(io::StateWriter& w) const {
+  const PressurePreconditionerHistory& h = pHistory_;
+  w.putBool("ready", pReady_);
+  w.putBool("refreshed", h.refreshed);
+  w.putInt("setupSweeps", h.setupSweeps);
+  w.putInt("refreshSweeps", h.refreshSweeps);
+  w.putInt("sweeps", h.sweeps);
+  w.putView("setupValues", h.setupValues);
+  w.putView("refreshValues", h.refreshed ? h.refreshValues : RealView());
+}
+
+void LinearSolver::loadPressurePreconditioner(const io::StateReader& r, const ExecSpace& exec, const CsrMatrix& A) {
+  if (!r.boolean("ready")) return;
+  auto* amg = dynamic_cast<AmgPreconditioner*>(pPrec_.get());
+  PressurePreconditionerHistory& h = pHistory_;
+  const bool refreshed = r.boolean("refreshed");
+  const int sweeps = static_cast<int>(r.integer("sweeps"));
+  const int setupSweeps = static_cast<int>(r.integer("setupSweeps"));
+  const int refreshSweeps = static_cast<int>(r.integer("refreshSweeps"));
+  const RealView values("mfsi::fluid::pressure::checkpointValues", A.values.extent(0));
+  r.getView("setupValues", values);
+  Kokkos::deep_copy(exec, A.values, values);
+  pReady_ = false;
+  if (amg) amg->setFinestSweeps(setupSweeps);
+  pressureMatrixChanged(exec, A);
+  if (refreshed) {
+    r.getView("refreshValues", values);
+    Kokkos::deep_copy(exec, A.values, values);
+    if (amg) amg->setFinestSweeps(refreshSweeps);
+    pressureMatrixChanged(exec, A);
+  }
+  h.sweeps = sweeps;
+  if (amg) amg->setFinestSweeps(sweeps);
 }
 
 void LinearSolver::pressureValuesChanged(const ExecSpace& exec, const CsrMatrix& A) {
@@ -103,7 +146,10 @@ LinearSolveStats LinearSolver::solveMomentum(const ExecSpace& exec, const CsrMat
 
 LinearSolveStats LinearSolver::solvePressure(const ExecSpace& exec, const CsrMatrix& A, const ConstRealView& b,
                                              const RealView& x, const LinearSolverOptions& o) {
-  if (auto* amg = dynamic_cast<AmgPreconditioner*>(pPrec_.get())) amg->setFinestSweeps(o.amgFinestSweeps);
+  if (auto* amg = dynamic_cast<AmgPreconditioner*>(pPrec_.get())) {
+    amg->setFinestSweeps(o.amgFinestSweeps);
+    pHistory_.sweeps = o.amgFinestSweeps;
+  }
   return solve(exec, *pSolver_, *pPrec_, A, b, x, o);
 }
 

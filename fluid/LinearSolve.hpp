@@ -14,6 +14,7 @@
 /// forms r = b - A x and hands it to the Krylov solver as its starting residual (no second pass).
 /// All sums are deterministic (`blas::reduce`): solves are bitwise repeatable.
 #include "fluid/FluidOptions.hpp"
+#include "core/io/Checkpoint.hpp"
 #include "kernels/CsrMatrix.hpp"
 #include "kernels/Krylov.hpp"
 
@@ -86,6 +87,13 @@ class LinearSolver {
   real pressureStepAlong(const ExecSpace& exec, const CsrMatrix& A, const ConstRealView& b, const ConstRealView& x,
                          const ConstRealView& d);
 
+  /// \brief Write how the pressure preconditioner came to be (the matrix values of its set-up and
+  /// of its last refresh, and the AMG sweeps each saw) for a checkpoint.
+  void savePressurePreconditioner(io::StateWriter& w) const;
+  /// \brief Rebuild the pressure preconditioner from a checkpoint by replaying its set-up and last
+  /// refresh on A's sparsity: the same preconditioner, bit for bit. Overwrites A's values.
+  void loadPressurePreconditioner(const io::StateReader& r, const ExecSpace& exec, const CsrMatrix& A);
+
   /// \brief One Krylov solve with the statistics the solves above report (their shared step).
   /// Public only because nvcc compiles extended device lambdas solely in public member functions.
   LinearSolveStats solve(const ExecSpace& exec, KrylovSolver& solver, Preconditioner& M, const CsrMatrix& A,
@@ -101,6 +109,15 @@ class LinearSolver {
   bool uReady_ = false, pReady_ = false;
   RealView r_;
   Real3View r3_;
+  /// What the pressure preconditioner was built from, so that a checkpoint can rebuild it exactly:
+  /// the values of its set-up and of its last refresh (copied once per refresh), and the AMG
+  /// finest-level sweeps in force at each and now.
+  struct PressurePreconditionerHistory {
+    RealView setupValues, refreshValues;
+    bool refreshed = false;
+    int setupSweeps = 0, refreshSweeps = 0, sweeps = 0;
+  };
+  PressurePreconditionerHistory pHistory_;
 };
 
 }  // namespace mfsi::fluid

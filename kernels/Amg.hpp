@@ -188,6 +188,8 @@ class AmgPreconditioner final : public Preconditioner {
   /// change of the level's step coefficients, no set-up. A loose solve that a stronger cycle
   /// finishes one iteration sooner can ask for more than the tight solves that follow it.
   void setFinestSweeps(int sweeps);
+  /// The finest level's sweeps in force (options, or the last setFinestSweeps).
+  int finestSweeps() const { return options_.finestSweeps; }
   /// \brief z = one V-cycle applied to r, from a zero initial guess.
   void apply(const ExecSpace& exec, const ConstRealView& r, const RealView& z) override;
   std::string name() const override { return "amg"; }

@@ -38,6 +38,11 @@ void StateWriter::write(const std::string& name, const std::vector<std::int64_t>
 
 bool StateReader::has(const std::string& name) const { return file_->has(group_ + "/" + name); }
 
+std::vector<std::size_t> StateReader::shape(const std::string& name) const {
+  if (!has(name)) throw InputError(where(name) + ": missing (a checkpoint of another scene or version?)");
+  return file_->shape(group_ + "/" + name);
+}
+
 std::string StateReader::where(const std::string& name) const {
   return "checkpoint '" + file_->path() + "', '" + group_ + "/" + name + "'";
 }

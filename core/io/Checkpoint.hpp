@@ -83,6 +83,8 @@ class StateReader {
   StateReader sub(const std::string& name) const { return StateReader(*file_, group_ + "/" + name); }
 
   bool has(const std::string& name) const;
+  /// The stored shape of a dataset (InputError when it is missing).
+  std::vector<std::size_t> shape(const std::string& name) const;
   /// All values of a dataset; with `expected` >= 0 its size must be that.
   std::vector<double> doubles(const std::string& name, long long expected = -1) const;
   std::vector<std::int64_t> ints(const std::string& name, long long expected = -1) const;

@@ -139,7 +139,7 @@ void FieldSeries::write(const FieldFrame& frame) {
   if (ec) throw OutputError("cannot create '" + dir_ + "/fields': " + ec.message());
   char name[64];
   std::snprintf(name, sizeof name, "fields/fields_%06lld.h5", frame.step);
-  Entry entry{frame.time, name, {}};
+  Entry entry{frame.time, name, {}, frame.step};
 
   Hdf5File h5 = Hdf5File::create(dir_ + "/" + entry.file);
   h5.writeAttribute("time", frame.time);
@@ -206,6 +206,72 @@ void FieldSeries::write(const FieldFrame& frame) {
   }
   entries_.push_back(std::move(entry));
   writeTextAtomically(indexPath_, xdmf());
+}
+
+// One record per line, fields separated by tabs (names never hold tabs or line breaks):
+//   E time step file | G name shape nPoints nCells topologyType topologyDims | F key file |
+//   P/C name components vector geometric (no values: the index needs none).
+std::string FieldSeries::state() const {
+  std::ostringstream os;
+  os << std::setprecision(17);
+  for (const Entry& e : entries_) {
+    os << "E\t" << e.time << "\t" << e.step << "\t" << e.file << "\n";
+    for (const GridEntry& g : e.grids) {
+      os << "G\t" << g.name << "\t" << static_cast<int>(g.shape) << "\t" << g.nPoints << "\t" << g.nCells << "\t"
+         << g.topologyType << "\t" << g.topologyDims << "\n";
+      for (const auto& [key, file] : g.files) os << "F\t" << key << "\t" << file << "\n";
+      for (const auto& f : g.pointFields)
+        os << "P\t" << f.name << "\t" << f.components << "\t" << f.vector << "\t" << f.geometric << "\n";
+      for (const auto& f : g.cellFields)
+        os << "C\t" << f.name << "\t" << f.components << "\t" << f.vector << "\t" << f.geometric << "\n";
+    }
+  }
+  return os.str();
+}
+
+void FieldSeries::restore(const std::string& state, long long step) {
+  std::vector<Entry> entries;
+  std::istringstream in(state);
+  auto bad = [](const std::string& line) {
+    return InputError("restart: the checkpoint's list of field frames is damaged at '" + line + "'");
+  };
+  for (std::string line; std::getline(in, line);) {
+    std::vector<std::string> t;
+    std::istringstream ls(line);
+    for (std::string tok; std::getline(ls, tok, '\t');) t.push_back(tok);
+    try {
+      if (t.size() == 4 && t[0] == "E") {
+        entries.push_back(Entry{std::stod(t[1]), t[3], {}, std::stoll(t[2])});
+      } else if (t.size() == 7 && t[0] == "G" && !entries.empty()) {
+        GridEntry g;
+        g.name = t[1];
+        g.shape = static_cast<CellShape>(std::stoi(t[2]));
+        g.nPoints = std::stoull(t[3]);
+        g.nCells = std::stoull(t[4]);
+        g.topologyType = t[5];
+        g.topologyDims = t[6];
+        entries.back().grids.push_back(std::move(g));
+      } else if (t.size() == 3 && t[0] == "F" && !entries.empty() && !entries.back().grids.empty()) {
+        entries.back().grids.back().files[t[1]] = t[2];
+      } else if (t.size() == 5 && (t[0] == "P" || t[0] == "C") && !entries.empty() && !entries.back().grids.empty()) {
+        OutputField f;
+        f.name = t[1];
+        f.components = std::stoi(t[2]);
+        f.vector = t[3] == "1";
+        f.geometric = t[4] == "1";
+        auto& g = entries.back().grids.back();
+        (t[0] == "P" ? g.pointFields : g.cellFields).push_back(std::move(f));
+      } else {
+        throw bad(line);
+      }
+    } catch (const std::logic_error&) {
+      throw bad(line);
+    }
+  }
+  entries_.clear();
+  for (auto& e : entries)
+    if (e.step <= step) entries_.push_back(std::move(e));
+  written_.clear();
 }
 
 std::string FieldSeries::xdmf() const {

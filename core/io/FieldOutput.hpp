@@ -74,6 +74,12 @@ class FieldSeries {
   const std::string& indexPath() const { return indexPath_; }
   /// The HDF5 file of frame `i` (0-based, in writing order).
   std::string framePath(int i) const;
+  /// The index of the frames written so far, for a checkpoint: a run restarted in the same folder
+  /// lists them and its own (its first frame writes every grid's points and cells again).
+  std::string state() const;
+  /// Take over the frames of `state()` that are not later than `step` (a restarted run rewrites
+  /// the later ones). Throws InputError when the text is not such an index.
+  void restore(const std::string& state, long long step);
 
  private:
   struct GridEntry {
@@ -90,6 +96,7 @@ class FieldSeries {
     double time;
     std::string file;  ///< relative to the run folder
     std::vector<GridEntry> grids;
+    long long step = 0;
   };
   std::string xdmf() const;
 

@@ -156,6 +156,12 @@ std::int64_t Hdf5File::openDataset(const std::string& dataset, std::vector<std::
   return dset;
 }
 
+std::vector<std::size_t> Hdf5File::shape(const std::string& dataset) const {
+  std::vector<std::size_t> dims;
+  Handle dset(openDataset(dataset, &dims), H5Dclose);
+  return dims;
+}
+
 std::vector<double> Hdf5File::readDoubles(const std::string& dataset, std::vector<std::size_t>* dims) const {
   std::vector<std::size_t> shape;
   Handle dset(openDataset(dataset, &shape), H5Dclose);

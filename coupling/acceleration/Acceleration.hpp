@@ -11,6 +11,7 @@
 /// filter; IqnIls is the least-squares Jacobian update on top). All vectors are host vectors of
 /// this rank's interface entries; every inner product is a local sum completed by
 /// `SolverComm::globalSum`, so a distributed interface needs no change here.
+#include "core/io/Checkpoint.hpp"
 #include "kernels/Blas.hpp"
 
 #include <Eigen/Dense>
@@ -82,6 +83,11 @@ class Acceleration {
   AccelerationReport update(const InterfaceVector& xt, InterfaceVector& x);
   /// \brief The step's iterations are over (converged or not).
   virtual void endStep() {}
+  /// \brief What the method carries from one time step to the next (the quasi-Newton columns of
+  /// past steps), for a checkpoint. Checkpoints are written between steps, and everything else
+  /// restarts with each step (beginStep), so relaxation methods keep nothing.
+  virtual void saveState(io::StateWriter& /*w*/) const {}
+  virtual void loadState(const io::StateReader& /*r*/) {}
   /// \brief Forget what was learnt in this step (the next update is a first one): the caller
   /// replaced the iterate the last update asked for (e.g. the mesh could not follow it).
   void resetHistory() { restart(); }

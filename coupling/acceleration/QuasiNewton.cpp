@@ -26,6 +26,39 @@ void QuasiNewton::beginStep() {
   aitken_.reset();
 }
 
+void QuasiNewton::saveState(io::StateWriter& w) const {
+  w.putInt("stepIndex", stepIndex_);
+  w.putInt("size", size_);
+  std::vector<double> v, wv;
+  std::vector<std::int64_t> steps;
+  for (const Column& c : columns_) {
+    v.insert(v.end(), c.v.data(), c.v.data() + c.v.size());
+    wv.insert(wv.end(), c.w.data(), c.w.data() + c.w.size());
+    steps.push_back(c.step);
+  }
+  w.put("columnSteps", steps);
+  w.put("V", v);
+  w.put("W", wv);
+}
+
+void QuasiNewton::loadState(const io::StateReader& r) {
+  if (r.integer("size") != size_)
+    throw InputError(r.where("size") + ": an interface of " + std::to_string(r.integer("size")) +
+                     " unknowns, the run has " + std::to_string(size_) + " (another scene?)");
+  stepIndex_ = static_cast<long>(r.integer("stepIndex"));
+  const auto steps = r.ints("columnSteps");
+  const long long n = static_cast<long long>(steps.size()) * size_;
+  const auto v = r.doubles("V", n), wv = r.doubles("W", n);
+  columns_.clear();
+  for (std::size_t i = 0; i < steps.size(); ++i) {
+    Column c;
+    c.v = Eigen::Map<const InterfaceVector>(v.data() + i * size_, size_);
+    c.w = Eigen::Map<const InterfaceVector>(wv.data() + i * size_, size_);
+    c.step = static_cast<long>(steps[i]);
+    columns_.push_back(std::move(c));
+  }
+}
+
 void QuasiNewton::restart() {
   columns_.clear();
   havePrevious_ = false;

@@ -21,6 +21,9 @@ class QuasiNewton : public Acceleration {
  public:
   QuasiNewton(const AccelerationOptions& options, std::vector<InterfaceBlock> layout, const SolverComm& comm);
   void beginStep() override;
+  /// The columns kept for later steps (iqnReuseCols) and the step count that ages them.
+  void saveState(io::StateWriter& w) const override;
+  void loadState(const io::StateReader& r) override;
   /// Columns in the history now.
   int columns() const { return static_cast<int>(columns_.size()); }
 

@@ -168,4 +168,14 @@ MotionReport MeshSmoother::move(const ExecSpace& exec) {
   return rep;
 }
 
+void MeshSmoother::saveState(io::StateWriter& w) const {
+  w.putView("displacement", d_);
+  w.putView("accepted", good_);
+}
+
+void MeshSmoother::loadState(const io::StateReader& r) {
+  r.getView("displacement", d_);
+  r.getView("accepted", good_);
+}
+
 }  // namespace mfsi::coupling

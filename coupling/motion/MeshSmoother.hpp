@@ -9,6 +9,7 @@
 /// points become reference + displacement, and the minimum scaled Jacobian is checked. Smoothing
 /// the displacement, not the positions, keeps a graded mesh whose boundary does not move
 /// bit-identical (zero stays exactly zero), and a warm start needs few sweeps per FSI iteration.
+#include "core/io/Checkpoint.hpp"
 #include "core/MeshGeometry.hpp"
 #include "kernels/JacobiSmoothing.hpp"
 #include "kernels/LaplacianCg.hpp"
@@ -71,6 +72,11 @@ class MeshSmoother {
   /// (the fluid does, once per motion). Throws DivergenceError when a cell is still inverted, with
   /// the mesh (points, displacement) restored to the last accepted motion.
   MotionReport move(const ExecSpace& exec);
+
+  /// The displacement of the last motion (the next one's warm start) and of the last accepted one,
+  /// for a checkpoint.
+  void saveState(io::StateWriter& w) const;
+  void loadState(const io::StateReader& r);
 
   /// Points = reference + d (one kernel; no fence).
   void place(const ExecSpace& exec, const ConstReal3View& d) const;

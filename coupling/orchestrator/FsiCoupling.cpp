@@ -665,12 +665,93 @@ ModuleEntry couplingModuleEntry() {
           }};
 }
 
-void FsiCoupling::saveState(io::StateWriter& /*w*/) const {
-  throw InputError(name() + ": checkpoints are not available for this module yet");
+// The fluid, the membranes and the bodies write their own state (they are parts of the run);
+// the coupling adds what it carries between steps: the loads in use (and filtered), the wall
+// velocities, the mesh motion's warm start, the bodies' transforms, the acceleration's history
+// (IQN-ILS columns reused across steps) and its counters.
+void FsiCoupling::saveState(io::StateWriter& w) const {
+  exec_.fence();
+  for (std::size_t i = 0; i < panels_.size(); ++i) {
+    const Panel& p = panels_[i];
+    io::StateWriter pw = w.sub("panel" + std::to_string(i));
+    pw.putView("load", p.load);
+    pw.putView("loadPrevious", p.loadPrevious);
+    pw.putView("force", p.force);
+    pw.putView("forcePrevious", p.forcePrevious);
+    pw.putView("faceVelocity", p.faceVelocity);
+    pw.putView("filtered", p.filtered);
+    pw.putBool("haveFiltered", p.haveFiltered);
+  }
+  std::vector<double> tr;
+  for (const auto& T : transforms_) {
+    tr.insert(tr.end(), T.c0.begin(), T.c0.end());
+    tr.insert(tr.end(), T.c.begin(), T.c.end());
+    tr.insert(tr.end(), T.Q.begin(), T.Q.end());
+  }
+  w.put("transforms", tr);
+  if (smoother_) {
+    io::StateWriter sw = w.sub("meshMotion");
+    smoother_->saveState(sw);
+  }
+  io::StateWriter aw = w.sub("acceleration");
+  acceleration_->saveState(aw);
+  const StepReport& l = last_;
+  w.put("lastStep", std::vector<double>{double(l.iterations), double(l.structureSolves), double(l.converged),
+                                        l.displacementResidual, l.forceResidual, l.omega, double(l.columns),
+                                        l.minScaledJacobian, double(l.cutBacks), double(l.motionIterations),
+                                        double(l.limited), stepEnd_, forceResidual_, minJacobian_});
+  w.put("counters", std::vector<std::int64_t>{steps_, iterationsTotal_, unconvergedSteps_, unconvergedInARow_,
+                                              cutBacksTotal_, limitedTotal_, maxIterations_});
 }
 
-void FsiCoupling::loadState(const io::StateReader& /*r*/) {
-  throw InputError(name() + ": restart is not available for this module yet");
+void FsiCoupling::loadState(const io::StateReader& r) {
+  for (std::size_t i = 0; i < panels_.size(); ++i) {
+    Panel& p = panels_[i];
+    const io::StateReader pr = r.sub("panel" + std::to_string(i));
+    pr.getView("load", p.load);
+    pr.getView("loadPrevious", p.loadPrevious);
+    pr.getView("force", p.force);
+    pr.getView("forcePrevious", p.forcePrevious);
+    pr.getView("faceVelocity", p.faceVelocity);
+    pr.getView("filtered", p.filtered);
+    p.haveFiltered = pr.boolean("haveFiltered");
+  }
+  const auto tr = r.doubles("transforms", 15 * static_cast<long long>(transforms_.size()));
+  for (std::size_t b = 0; b < transforms_.size(); ++b) {
+    auto& T = transforms_[b];
+    std::copy(tr.begin() + 15 * b, tr.begin() + 15 * b + 3, T.c0.begin());
+    std::copy(tr.begin() + 15 * b + 3, tr.begin() + 15 * b + 6, T.c.begin());
+    std::copy(tr.begin() + 15 * b + 6, tr.begin() + 15 * b + 15, T.Q.begin());
+  }
+  if (!transforms_.empty())
+    for (Panel& p : panels_)
+      if (p.mounted) p.parents.setTransforms(transforms_);
+  if (smoother_) smoother_->loadState(r.sub("meshMotion"));
+  acceleration_->loadState(r.sub("acceleration"));
+  const auto v = r.doubles("lastStep", 14);
+  StepReport& l = last_;
+  l.iterations = static_cast<int>(v[0]);
+  l.structureSolves = static_cast<int>(v[1]);
+  l.converged = v[2] != 0;
+  l.displacementResidual = v[3];
+  l.forceResidual = v[4];
+  l.omega = v[5];
+  l.columns = static_cast<int>(v[6]);
+  l.minScaledJacobian = v[7];
+  l.cutBacks = static_cast<int>(v[8]);
+  l.motionIterations = static_cast<int>(v[9]);
+  l.limited = static_cast<int>(v[10]);
+  stepEnd_ = v[11];
+  forceResidual_ = v[12];
+  minJacobian_ = v[13];
+  const auto c = r.ints("counters", 7);
+  steps_ = c[0];
+  iterationsTotal_ = c[1];
+  unconvergedSteps_ = c[2];
+  unconvergedInARow_ = c[3];
+  cutBacksTotal_ = c[4];
+  limitedTotal_ = c[5];
+  maxIterations_ = static_cast<int>(c[6]);
 }
 
 }  // namespace mfsi
