@@ -3,7 +3,7 @@
 //   mfsi run                                  # the default scene (membrane-channel), results in results/<scene>/
 //   mfsi run cases/box.yaml --out /tmp/box --threads 2 [--overwrite]
 //   mfsi run --restart /tmp/box               # continue a run from its latest checkpoint
-//   mfsi run box --set mesh.blocks.0.cells=[32,32,8]
+//   mfsi run box --set mesh.blocks.0.cells=[32,16,16] --set mesh.blocks.1.cells=[48,16,16]
 //   mfsi check cases/box.yaml                 # validate without running (also builds the mesh)
 //   mfsi check --describe                     # every scene key with type, default, units, doc
 //   mfsi scenes                               # built-in scenes

@@ -4,6 +4,8 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
+#include <sstream>
 #include <tuple>
 
 namespace mfsi {
@@ -26,7 +28,149 @@ std::vector<real> gradedCoordinates(real a, real b, int n, real ratio) {
   return x;
 }
 
+/// Nodes closer than this (per coordinate) are merged: `mergeTolerance` times the diagonal of the
+/// bounding box of all blocks.
+real mergeDistance(const BlockMeshSpec& spec) {
+  std::array<real, 3> lo = spec.blocks[0].min, hi = spec.blocks[0].max;
+  for (const auto& bl : spec.blocks)
+    for (int d = 0; d < 3; ++d) {
+      lo[d] = std::min(lo[d], bl.min[d]);
+      hi[d] = std::max(hi[d], bl.max[d]);
+    }
+  const real diag = std::sqrt((hi[0] - lo[0]) * (hi[0] - lo[0]) + (hi[1] - lo[1]) * (hi[1] - lo[1]) +
+                              (hi[2] - lo[2]) * (hi[2] - lo[2]));
+  return spec.mergeTolerance * diag;
+}
+
+bool validBlock(const BlockSpec& bl) {
+  for (int d = 0; d < 3; ++d)
+    if (bl.cells[d] < 1 || !(bl.max[d] > bl.min[d]) || !(bl.grading[d] > 0)) return false;
+  return true;
+}
+
+/// The node coordinates of a block along `dir`.
+std::vector<real> gridLine(const BlockSpec& bl, int dir) {
+  return gradedCoordinates(bl.min[dir], bl.max[dir], bl.cells[dir], bl.grading[dir]);
+}
+
+/// How the upper (`upperOfA`) or lower side of block a along `dir` meets the opposite side of block
+/// b, which lies on the same plane: nothing when they share no area or their grids match there.
+std::optional<BlockMismatch> compareContact(const BlockMeshSpec& spec, std::size_t a, std::size_t b, int dir,
+                                            bool upperOfA, real tol) {
+  const BlockSpec& A = spec.blocks[a];
+  const BlockSpec& B = spec.blocks[b];
+  const int along[2] = {dir == 0 ? 1 : 0, dir == 2 ? 1 : 2};
+  real lo[2], hi[2];
+  for (int t = 0; t < 2; ++t) {
+    const int e = along[t];
+    lo[t] = std::max(A.min[e], B.min[e]);
+    hi[t] = std::min(A.max[e], B.max[e]);
+    if (hi[t] - lo[t] <= tol) return std::nullopt;  // an edge or a corner, or apart: nothing to glue
+  }
+  BlockMismatch m;
+  m.block = {a, b};
+  m.side = {static_cast<BoxSide>(2 * dir + (upperOfA ? 1 : 0)), static_cast<BoxSide>(2 * dir + (upperOfA ? 0 : 1))};
+  m.along = {along[0], along[1]};
+  bool conforming = true, sameCells = true, wholeFaces = true;
+  for (int t = 0; t < 2; ++t) {
+    const int e = along[t];
+    // Grid lines of each block on the shared part [lo, hi], and the cells that touch it.
+    std::array<std::vector<real>, 2> lines;
+    for (int k = 0; k < 2; ++k) {
+      const auto x = gridLine(spec.blocks[m.block[k]], e);
+      long long touching = 0;
+      for (std::size_t i = 0; i < x.size(); ++i) {
+        if (x[i] >= lo[t] - tol && x[i] <= hi[t] + tol) lines[k].push_back(x[i]);
+        if (i + 1 < x.size() && x[i + 1] > lo[t] + tol && x[i] < hi[t] - tol) ++touching;
+      }
+      m.cells[k][t] = touching;
+    }
+    sameCells = sameCells && m.cells[0][t] == m.cells[1][t];
+    wholeFaces = wholeFaces && std::abs(A.min[e] - B.min[e]) <= tol && std::abs(A.max[e] - B.max[e]) <= tol;
+    bool match = lines[0].size() == lines[1].size() && !lines[0].empty() && std::abs(lines[0].front() - lo[t]) <= tol &&
+                 std::abs(lines[0].back() - hi[t]) <= tol;
+    for (std::size_t i = 0; match && i < lines[0].size(); ++i) match = std::abs(lines[0][i] - lines[1][i]) <= tol;
+    conforming = conforming && match;
+  }
+  if (conforming) return std::nullopt;
+  m.cause = !sameCells ? BlockMismatch::Cause::Cells
+                       : (wholeFaces ? BlockMismatch::Cause::Grading : BlockMismatch::Cause::Extent);
+  return m;
+}
+
 }  // namespace
+
+double BlockMeshCounts::largest() const { return std::max({cells, nodes, faces}); }
+
+BlockMeshCounts countBlock(const BlockSpec& block) {
+  const double nx = block.cells[0], ny = block.cells[1], nz = block.cells[2];
+  BlockMeshCounts c;
+  c.cells = nx * ny * nz;
+  c.nodes = (nx + 1) * (ny + 1) * (nz + 1);
+  c.faces = (nx + 1) * ny * nz + nx * (ny + 1) * nz + nx * ny * (nz + 1);
+  return c;
+}
+
+BlockMeshCounts countBlockMesh(const BlockMeshSpec& spec) {
+  BlockMeshCounts total;
+  for (const auto& bl : spec.blocks) {
+    const BlockMeshCounts c = countBlock(bl);
+    total.cells += c.cells;
+    total.nodes += c.nodes;
+    total.faces += c.faces;
+  }
+  return total;
+}
+
+const char* sideName(BoxSide side) {
+  static const char* const names[6] = {"-x", "+x", "-y", "+y", "-z", "+z"};
+  return names[static_cast<int>(side)];
+}
+
+std::string BlockMismatch::describe(const std::string& name0, const std::string& name1) const {
+  std::ostringstream os;
+  const char* xyz = "xyz";
+  auto grid = [&](int k) { return std::to_string(cells[k][0]) + "x" + std::to_string(cells[k][1]); };
+  const std::string dirs = std::string("(") + xyz[along[0]] + " x " + xyz[along[1]] + ")";
+  os << name0 << " face " << sideName(side[0]) << " and " << name1 << " face " << sideName(side[1]);
+  switch (cause) {
+    case Cause::Cells:
+      os << " touch but their grids differ: " << grid(0) << " cells against " << grid(1) << " cells " << dirs
+         << "; give both the same cells on the shared face";
+      break;
+    case Cause::Grading:
+      os << " touch with the same " << grid(0) << " cells " << dirs
+         << " but their grids differ (different grading), so their nodes do not meet; give both the same grading "
+            "along the shared face";
+      break;
+    case Cause::Extent:
+      os << " touch on part of their faces but their grids differ there (" << grid(0) << " cells against " << grid(1)
+         << " cells " << dirs
+         << " meet the shared part); make the shared part end on grid lines of both, with the same cells across it";
+      break;
+  }
+  return os.str();
+}
+
+std::optional<BlockMismatch> findMismatchedContact(const BlockMeshSpec& spec) {
+  if (spec.blocks.empty()) return std::nullopt;
+  const real tol = mergeDistance(spec);
+  for (std::size_t a = 0; a < spec.blocks.size(); ++a) {
+    if (!validBlock(spec.blocks[a])) continue;
+    for (std::size_t b = a + 1; b < spec.blocks.size(); ++b) {
+      if (!validBlock(spec.blocks[b])) continue;
+      const BlockSpec& A = spec.blocks[a];
+      const BlockSpec& B = spec.blocks[b];
+      for (int d = 0; d < 3; ++d) {
+        std::optional<BlockMismatch> m;
+        if (std::abs(A.max[d] - B.min[d]) <= tol) m = compareContact(spec, a, b, d, true, tol);
+        if (!m && std::abs(A.min[d] - B.max[d]) <= tol) m = compareContact(spec, a, b, d, false, tol);
+        if (m) return m;
+      }
+    }
+  }
+  return std::nullopt;
+}
 
 BlockMeshSpec boxSpec(std::array<real, 3> min, std::array<real, 3> max, std::array<int, 3> cells) {
   BlockMeshSpec s;
@@ -44,21 +188,24 @@ HexMeshInput generateBlockMesh(const BlockMeshSpec& spec) {
   out.source = "blockMesh";
   out.defaultPatch = spec.defaultPatch;
 
-  // Bounding box, for the merge tolerance.
-  std::array<real, 3> lo = spec.blocks[0].min, hi = spec.blocks[0].max;
   for (std::size_t b = 0; b < spec.blocks.size(); ++b) {
     const auto& bl = spec.blocks[b];
     for (int d = 0; d < 3; ++d) {
       MFSI_CHECK(bl.cells[d] >= 1, "blockMesh: block " << b << " needs at least one cell in direction " << d);
       MFSI_CHECK(bl.max[d] > bl.min[d], "blockMesh: block " << b << " has max <= min in direction " << d);
       MFSI_CHECK(bl.grading[d] > 0, "blockMesh: block " << b << " has non-positive grading in direction " << d);
-      lo[d] = std::min(lo[d], bl.min[d]);
-      hi[d] = std::max(hi[d], bl.max[d]);
     }
   }
-  const real diag = std::sqrt((hi[0] - lo[0]) * (hi[0] - lo[0]) + (hi[1] - lo[1]) * (hi[1] - lo[1]) +
-                              (hi[2] - lo[2]) * (hi[2] - lo[2]));
-  const real tol = spec.mergeTolerance * diag;
+  // Before allocating anything: every count must fit the index type.
+  const BlockMeshCounts counts = countBlockMesh(spec);
+  MFSI_CHECK(counts.largest() <= static_cast<double>(std::numeric_limits<lid_t>::max()),
+             "blockMesh: the blocks make " << counts.cells << " cells, " << counts.nodes << " nodes and "
+                                           << counts.faces << " faces, more than the "
+                                           << std::numeric_limits<lid_t>::max() << " one rank can index (lid_t)");
+  if (const auto m = findMismatchedContact(spec))
+    throw InputError("blockMesh: " +
+                     m->describe("block " + std::to_string(m->block[0]), "block " + std::to_string(m->block[1])));
+  const real tol = mergeDistance(spec);
 
   // Merge coincident nodes through a quantised-coordinate map.
   std::map<std::tuple<long long, long long, long long>, lid_t> nodeOf;

@@ -1,11 +1,14 @@
 #pragma once
 /// \file
 /// \brief Structured block generator: boxes with per-direction cell counts and grading, glued
-/// where they touch, named patches per side, and baffles declared as rectangles on grid planes.
-/// Produces the same unstructured `HexMeshInput` as the file readers.
+/// where they touch (touching sides must have the same grid there), named patches per side, and
+/// baffles declared as rectangles on grid planes. Produces the same unstructured `HexMeshInput` as
+/// the file readers.
 #include "core/HexMesh.hpp"
 
 #include <map>
+#include <optional>
+#include <string>
 
 namespace mfsi {
 
@@ -42,8 +45,56 @@ struct BlockMeshSpec {
   real mergeTolerance = 1e-9;
 };
 
+/// \brief Entity counts of a block, or of a whole spec before gluing (an upper bound of the glued
+/// mesh). Doubles, so that absurd cell counts are counted exactly enough to be refused instead of
+/// overflowing.
+struct BlockMeshCounts {
+  double cells = 0;
+  double nodes = 0;
+  double faces = 0;
+  /// The largest of the three counts: what must fit the local index type lid_t.
+  double largest() const;
+};
+
+/// Counts of one block.
+BlockMeshCounts countBlock(const BlockSpec& block);
+/// Counts of all blocks together, shared interfaces counted twice.
+BlockMeshCounts countBlockMesh(const BlockMeshSpec& spec);
+
+/// \brief Two block sides that touch (coplanar, opposite outward normals, overlapping in area) but
+/// whose grids differ on the shared part, so their nodes cannot be merged and the blocks would stay
+/// unglued (an internal boundary). `block[0] < block[1]`.
+struct BlockMismatch {
+  /// What differs; the config layer names the scene key to fix from it.
+  enum class Cause {
+    Cells,    ///< the cell counts across the shared part differ
+    Grading,  ///< same faces and cell counts, but the node positions (grading) differ
+    Extent    ///< the shared part is not bounded by grid lines of both blocks (partial overlap)
+  };
+  std::array<std::size_t, 2> block{0, 0};
+  std::array<BoxSide, 2> side{BoxSide::XMin, BoxSide::XMin};
+  /// The two in-plane directions (0 = x, 1 = y, 2 = z), in increasing order.
+  std::array<int, 2> along{0, 0};
+  /// Cells of each block that touch the shared part, along `along[0]` and `along[1]`.
+  std::array<std::array<long long, 2>, 2> cells{};
+  Cause cause = Cause::Cells;
+
+  /// A readable account naming the blocks `name0` and `name1`, e.g. "mesh.blocks.0 face +x and
+  /// mesh.blocks.1 face -x touch but their grids differ: 32x8 cells against 10x10 cells (y x z);
+  /// give both the same cells on the shared face".
+  std::string describe(const std::string& name0, const std::string& name1) const;
+};
+
+/// Short name of a side: "-x", "+x", ..., "+z".
+const char* sideName(BoxSide side);
+
+/// \brief The first pair of touching block sides whose grids differ, if any (O(blocks^2) box tests,
+/// plus the grid coordinates of the touching sides).
+std::optional<BlockMismatch> findMismatchedContact(const BlockMeshSpec& spec);
+
 /// Generate the mesh description. Throws InputError for invalid specs (non-positive counts or sizes,
-/// baffles that select no face).
+/// more cells, nodes or faces than lid_t indexes, touching blocks whose grids differ, baffles that
+/// select no face).
 HexMeshInput generateBlockMesh(const BlockMeshSpec& spec);
 
 /// Convenience: a single box.

@@ -7,6 +7,7 @@
 #include <cctype>
 #include <charconv>
 #include <fstream>
+#include <limits>
 #include <map>
 #include <sstream>
 #include <string_view>
@@ -42,8 +43,13 @@ class FoamLexer {
   FoamLexer(const FoamLexer&) = delete;
   FoamLexer& operator=(const FoamLexer&) = delete;
 
-  /// Read the FoamFile header if there is one; rejects binary files. Returns the header's class.
-  std::string readHeader();
+  /// What the FoamFile header says.
+  struct Header {
+    std::string foamClass;
+    long long nCells = -1;  ///< from `note "... nCells:N ..."` (OpenFOAM writes it in owner), -1: not given
+  };
+  /// Read the FoamFile header if there is one; rejects binary files.
+  Header readHeader();
 
   Token next() {
     Token t = peek();
@@ -132,6 +138,8 @@ class FoamLexer {
 
   int lastLine() const { return line_; }
   const std::string& path() const { return path_; }
+  /// Bytes of the file not read yet.
+  std::size_t bytesLeft() const { return text_.size() - std::min(pos_, text_.size()); }
 
   [[noreturn]] void failAt(int line, const std::string& msg) const {
     const std::string item = itemKind_ ? std::string(itemKind_) + " " + std::to_string(itemIndex_) + ": " : "";
@@ -180,9 +188,9 @@ class FoamLexer {
   int peekLine_ = 1;
 };
 
-std::string FoamLexer::readHeader() {
+FoamLexer::Header FoamLexer::readHeader() {
   FoamLexer& lx = *this;
-  std::string foamClass;
+  Header h;
   const Token first = lx.peek();
   if (first.kind == Token::Kind::Word && first.text == "FoamFile") {
     lx.next();
@@ -197,18 +205,43 @@ std::string FoamLexer::readHeader() {
         lx.failAt(value.line, "format '" + std::string(value.text) +
                                   "' is not supported, only ascii (set writeFormat ascii in system/controlDict "
                                   "and run foamFormatConvert)");
-      if (key.text == "class") foamClass = std::string(value.text);
+      if (key.text == "class") h.foamClass = std::string(value.text);
+      if (key.text == "note") {
+        const std::string_view note = value.text;
+        const std::size_t at = note.find("nCells:");
+        if (at != std::string_view::npos) {
+          std::size_t p = at + 7;
+          while (p < note.size() && note[p] == ' ') ++p;
+          long long n = -1;
+          const auto [end, ec] = std::from_chars(note.data() + p, note.data() + note.size(), n);
+          if (ec == std::errc() && end != note.data() + p) h.nCells = n;
+        }
+      }
       for (Token t = value; !(t.kind == Token::Kind::Punct && t.text[0] == ';'); t = lx.next())
         if (t.kind == Token::Kind::End) lx.failAt(t.line, "unterminated FoamFile header");
     }
   }
-  return foamClass;
+  return h;
 }
 
-/// Start of a list: "N (" or "(". Returns N, or -1 when the size is not given.
-long long listStart(FoamLexer& lx, const std::string& what) {
+/// Start of a list: "N (" or "(". Returns N, or -1 when the size is not given. An entry takes at
+/// least `minBytes` characters with its separator, so an N the rest of the file cannot hold, or one
+/// lid_t cannot index, is refused here, before anything is reserved for it.
+long long listStart(FoamLexer& lx, const std::string& what, std::size_t minBytes) {
   long long n = -1;
-  if (lx.peek().kind == Token::Kind::Word) n = lx.integer(("the size of the " + what + " list").c_str());
+  if (lx.peek().kind == Token::Kind::Word) {
+    n = lx.integer(("the size of the " + what + " list").c_str());
+    const long long fits = static_cast<long long>(lx.bytesLeft() / minBytes) + 1;
+    std::string why;
+    if (n < 0)
+      why = "a size cannot be negative";
+    else if (n > fits)
+      why = "the rest of the file (" + std::to_string(lx.bytesLeft()) + " bytes) holds at most " + std::to_string(fits);
+    else if (n > std::numeric_limits<lid_t>::max())
+      why = "one rank indexes at most " + std::to_string(std::numeric_limits<lid_t>::max()) + " (lid_t is 32-bit)";
+    if (!why.empty())
+      lx.failAt(lx.lastLine(), "the " + what + " list announces " + std::to_string(n) + " entries, but " + why);
+  }
   const Token open = lx.peek();
   if (open.kind == Token::Kind::Punct && open.text[0] == '{')
     lx.failAt(open.line, "uniform list syntax N{...} is not supported for the " + what + " list");
@@ -237,7 +270,7 @@ void listEnd(FoamLexer& lx, long long expected, std::size_t got, const std::stri
 std::vector<std::array<real, 3>> readPoints(const std::string& dir) {
   FoamLexer lx(dir, "points");
   lx.readHeader();
-  const long long n = listStart(lx, "points");
+  const long long n = listStart(lx, "points", 7);  // "(x y z)"
   std::vector<std::array<real, 3>> pts;
   if (n > 0) pts.reserve(static_cast<std::size_t>(n));
   while (!atListEnd(lx)) {
@@ -261,10 +294,10 @@ struct FaceList {
 
 FaceList readFaces(const std::string& dir) {
   FoamLexer lx(dir, "faces");
-  const std::string cls = lx.readHeader();
+  const std::string cls = lx.readHeader().foamClass;
   MFSI_CHECK(cls != "faceCompactList", lx.path() << ": compact face lists (faceCompactList) are not supported; "
                                                     "write the mesh in ascii format as a faceList");
-  const long long n = listStart(lx, "faces");
+  const long long n = listStart(lx, "faces", 3);  // "0()"
   FaceList fl;
   while (!atListEnd(lx)) {
     lx.setItem("face", static_cast<long long>(fl.quads.size()));
@@ -288,17 +321,29 @@ FaceList readFaces(const std::string& dir) {
   return fl;
 }
 
-std::vector<lid_t> readLabels(const std::string& dir, const std::string& name) {
+/// The cell labels of `owner` or `neighbour`. Cells are numbered by these labels, so each must lie
+/// in [0, nCells): nCells is the header's note where it gives one, and at most half the number of
+/// faces in any case (a cell has at least four faces, a face at most two cells). A label past that
+/// is refused here, naming its line, instead of sizing the cell arrays.
+std::vector<lid_t> readLabels(const std::string& dir, const std::string& name, lid_t nFaces) {
   FoamLexer lx(dir, name);
-  lx.readHeader();
-  const long long n = listStart(lx, name);
+  const FoamLexer::Header header = lx.readHeader();
+  const long long faceBound = nFaces / 2;
+  const bool fromNote = header.nCells >= 0 && header.nCells <= faceBound;
+  const long long nCells = fromNote ? header.nCells : faceBound;
+  const std::string why =
+      fromNote ? "the header's note gives nCells " + std::to_string(nCells)
+               : "the mesh has " + std::to_string(nFaces) + " faces, so at most " + std::to_string(nCells) + " cells";
+  const long long n = listStart(lx, name, 2);  // "0 "
   std::vector<lid_t> v;
   if (n > 0) v.reserve(static_cast<std::size_t>(n));
   while (!atListEnd(lx)) {
     lx.setItem("entry", static_cast<long long>(v.size()));
     // Old meshes pad neighbour with -1 for boundary faces.
     const long long x = lx.integer("a cell label");
-    if (x < -1 || x > 2147483647LL) lx.failAt(lx.lastLine(), "cell label " + std::to_string(x) + " is out of range");
+    if (x < -1 || x >= nCells)
+      lx.failAt(lx.lastLine(),
+                "cell label " + std::to_string(x) + " is out of range [0, " + std::to_string(nCells) + "): " + why);
     v.push_back(static_cast<lid_t>(x));
   }
   lx.setItem(nullptr, -1);
@@ -315,7 +360,7 @@ struct BoundaryEntry {
 std::vector<BoundaryEntry> readBoundary(const std::string& dir) {
   FoamLexer lx(dir, "boundary");
   lx.readHeader();
-  const long long n = listStart(lx, "boundary");
+  const long long n = listStart(lx, "boundary", 3);  // "p{}"
   std::vector<BoundaryEntry> out;
   while (!atListEnd(lx)) {
     BoundaryEntry e;
@@ -385,8 +430,8 @@ HexMeshInput readPolyMesh(const std::string& dir) {
   out.source = dir;
   out.points = readPoints(dir);
   const FaceList faces = readFaces(dir);
-  const std::vector<lid_t> owner = readLabels(dir, "owner");
-  const std::vector<lid_t> neighbour = readLabels(dir, "neighbour");
+  const std::vector<lid_t> owner = readLabels(dir, "owner", static_cast<lid_t>(faces.quads.size()));
+  const std::vector<lid_t> neighbour = readLabels(dir, "neighbour", static_cast<lid_t>(faces.quads.size()));
   const std::vector<BoundaryEntry> boundary = readBoundary(dir);
 
   const std::string facesPath = dir + "/faces", ownerPath = dir + "/owner", neighbourPath = dir + "/neighbour";
@@ -501,7 +546,7 @@ HexMeshInput readPolyMesh(const std::string& dir) {
       throw InputError(where, "patch '" + e.name + "' of type " + e.type +
                                   ": this is one piece of a decomposed mesh; read the undecomposed mesh "
                                   "(or run reconstructParMesh) instead");
-    if (e.startFace + e.nFaces > nFaces)
+    if (e.nFaces > nFaces || e.startFace > nFaces - e.nFaces)
       throw InputError(where, "patch '" + e.name + "' (startFace " + std::to_string(e.startFace) + ", nFaces " +
                                   std::to_string(e.nFaces) + ") runs past the " + std::to_string(nFaces) +
                                   " faces of the mesh");

@@ -18,7 +18,10 @@ namespace mfsi {
 ///
 /// Throws InputError naming the file (and line where one applies) for: missing or compressed
 /// files, binary format, malformed content, non-hex cells ("non-hex cell <id>"), patch ranges
-/// outside the boundary faces, and decomposed (processor) meshes.
+/// outside the boundary faces, and decomposed (processor) meshes. Sizes and labels are checked
+/// before anything is allocated from them: a list size the rest of its file cannot hold, and an
+/// owner/neighbour label outside [0, nCells) (nCells from the header's note, at most half the
+/// faces) are refused naming the line and entry.
 HexMeshInput readPolyMesh(const std::string& dir);
 
 }  // namespace mfsi

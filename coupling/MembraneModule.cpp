@@ -2,6 +2,7 @@
 
 #include "core/io/HostCopy.hpp"
 
+#include <algorithm>
 #include <cmath>
 
 namespace mfsi {
@@ -172,12 +173,26 @@ ModuleEntry membraneModuleEntry() {
           }};
 }
 
-void MembraneModule::saveState(io::StateWriter& /*w*/) const {
-  throw InputError(name() + ": checkpoints are not available for this module yet");
+void MembraneModule::saveState(io::StateWriter& w) const {
+  io::StateWriter solver = w.sub("solver");
+  solver_->saveState(solver);
+  w.putBool("solved", solved_);
+  w.putReal("maxDisplacement", maxU_);
+  w.putReal("centreDeflection", centreW_);
+  w.put("centreDisplacement", std::vector<double>(centreU_.begin(), centreU_.end()));
+  w.put("history", history_);
+  w.putReal("dt", dt_);
 }
 
-void MembraneModule::loadState(const io::StateReader& /*r*/) {
-  throw InputError(name() + ": restart is not available for this module yet");
+void MembraneModule::loadState(const io::StateReader& r) {
+  solver_->loadState(r.sub("solver"));
+  solved_ = r.boolean("solved");
+  maxU_ = r.real("maxDisplacement");
+  centreW_ = r.real("centreDeflection");
+  const std::vector<double> c = r.doubles("centreDisplacement", 3);
+  std::copy(c.begin(), c.end(), centreU_.begin());
+  history_ = r.doubles("history");
+  dt_ = r.real("dt");
 }
 
 }  // namespace mfsi

@@ -22,9 +22,10 @@ class MembraneModule final : public Module {
   explicit MembraneModule(const MembranePanelOptions& options);
 
   void advance(const TimeState& t) override;
-
+  /// The solver's state (MembraneSolver::saveState) under "solver", whether a static panel has
+  /// been solved (a restarted run must not solve t = 0 again), the sampled values of steps.csv and
+  /// the centre-deflection history of the period estimate.
   void saveState(io::StateWriter& w) const override;
-
   void loadState(const io::StateReader& r) override;
   /// "<name>.<summary key>" for every entry of MembraneSolver::summary(), and the comparison with
   /// the reference solution: hencky_w0 and hencky_rel_err, or period, period_exact and period_rel_err.

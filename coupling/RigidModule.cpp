@@ -1,8 +1,10 @@
 #include "coupling/RigidModule.hpp"
 
+#include "core/RunLog.hpp"
 #include "structure/rigid/RigidConfig.hpp"
 
 #include <cmath>
+#include <sstream>
 
 namespace mfsi {
 
@@ -19,7 +21,13 @@ void RigidModule::recordStep() {
   const double e = system_.kineticEnergy() + system_.potentialEnergy();
   if (!std::isfinite(e)) throw DivergenceError("rigid bodies: non-finite energy at t = " + std::to_string(system_.time()));
   maxEnergyDrift_ = std::max(maxEnergyDrift_, std::abs(e - energy0_));
-  if (csv_.is_open()) system_.writeCsvRows(csv_);
+  if (csv_.is_open()) writeRows();
+}
+
+void RigidModule::writeRows() {
+  system_.writeCsvRows(csv_);
+  csv_.flush();
+  if (!csv_) throw OutputError("cannot write '" + csvPath_ + "' (is the disk full?)");
 }
 
 void RigidModule::addOutputFields(io::FieldFrame& frame) {
@@ -50,10 +58,26 @@ void RigidModule::addMetrics(std::map<std::string, double>& metrics) const {
   metrics["bodies.maxEnergyDrift"] = maxEnergyDrift_;
 }
 
-void RigidModule::openOutput(const std::string& dir, const OutputStart& /*start*/) {
-  csv_.open(dir + "/bodies.csv");
+void RigidModule::openOutput(const std::string& dir, const OutputStart& start) {
+  csvPath_ = dir + "/bodies.csv";
+  if (csv_.is_open()) csv_.close();
+  csv_.clear();
+  if (start.continueFiles) {
+    // nBodies rows at set-up (the state at firstStep) and after every committed step since.
+    std::ostringstream header;
+    RigidBodySystem::writeCsvHeader(header);
+    std::string h = header.str();
+    if (!h.empty() && h.back() == '\n') h.pop_back();
+    keepCsvRows(csvPath_, h, static_cast<long long>(system_.nBodies()) * (start.step - start.firstStep + 1));
+    csv_.open(csvPath_, std::ios::app);
+    if (!csv_) throw OutputError("cannot write '" + csvPath_ + "'");
+    return;
+  }
+  // A new file; a run restarted into a new folder starts it from the checkpoint's state.
+  csv_.open(csvPath_, std::ios::trunc);
+  if (!csv_) throw OutputError("cannot write '" + csvPath_ + "'");
   RigidBodySystem::writeCsvHeader(csv_);
-  system_.writeCsvRows(csv_);
+  writeRows();
 }
 
 std::vector<std::string> RigidModule::stepColumns() const { return {"kineticEnergy", "potentialEnergy", "iterations"}; }
@@ -72,12 +96,17 @@ ModuleEntry rigidModuleEntry() {
           }};
 }
 
-void RigidModule::saveState(io::StateWriter& /*w*/) const {
-  throw InputError(name() + ": checkpoints are not available for this module yet");
+void RigidModule::saveState(io::StateWriter& w) const {
+  io::StateWriter system = w.sub("system");
+  system_.saveState(system);
+  w.putReal("energy0", energy0_);
+  w.putReal("maxEnergyDrift", maxEnergyDrift_);
 }
 
-void RigidModule::loadState(const io::StateReader& /*r*/) {
-  throw InputError(name() + ": restart is not available for this module yet");
+void RigidModule::loadState(const io::StateReader& r) {
+  system_.loadState(r.sub("system"));
+  energy0_ = r.real("energy0");
+  maxEnergyDrift_ = r.real("maxEnergyDrift");
 }
 
 }  // namespace mfsi

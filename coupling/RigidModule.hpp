@@ -5,6 +5,7 @@
 #include "structure/rigid/RigidBodySystem.hpp"
 
 #include <fstream>
+#include <string>
 
 namespace mfsi {
 
@@ -12,12 +13,19 @@ class RigidModule final : public Module {
  public:
   explicit RigidModule(const RigidSystemOptions& options);
   void advance(const TimeState& t) override;
+  /// The system's state (RigidBodySystem::saveState) under "system", the energy at the start and
+  /// the largest energy drift so far.
   void saveState(io::StateWriter& w) const override;
   void loadState(const io::StateReader& r) override;
   void addMetrics(std::map<std::string, double>& metrics) const override;
   /// The grid "bodies": one point per body at its centre of mass, with its velocity, angular
   /// velocity, (roll, pitch, yaw), force and moment.
   void addOutputFields(io::FieldFrame& frame) override;
+  /// bodies.csv: a header, then one row per body at set-up and after every committed step. A run
+  /// restarted into a new folder starts a new file with the rows of the checkpoint's state; one that
+  /// continues the files keeps the header and the nBodies (start.step - start.firstStep + 1) rows
+  /// up to the checkpoint and appends. Throws OutputError (disk full) or InputError (the file to
+  /// continue does not fit).
   void openOutput(const std::string& dir, const OutputStart& start) override;
   std::vector<std::string> stepColumns() const override;
   void appendStepValues(std::vector<double>& values) const override;
@@ -27,7 +35,11 @@ class RigidModule final : public Module {
   void recordStep();
 
  private:
+  /// Append the rows of the latest state to bodies.csv and flush; OutputError when it fails.
+  void writeRows();
+
   RigidBodySystem system_;
+  std::string csvPath_;
   std::ofstream csv_;
   double energy0_ = 0.0;
   double maxEnergyDrift_ = 0.0;

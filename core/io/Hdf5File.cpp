@@ -4,6 +4,7 @@
 
 #include <hdf5.h>
 
+#include <algorithm>
 #include <filesystem>
 #include <sstream>
 #include <system_error>
@@ -154,6 +155,30 @@ std::int64_t Hdf5File::openDataset(const std::string& dataset, std::vector<std::
   H5Sget_simple_extent_dims(space.id, hd.data(), nullptr);
   if (dims) dims->assign(hd.begin(), hd.end());
   return dset;
+}
+
+namespace {
+/// H5Ovisit's callback: collect the paths of datasets (the signature changed in HDF5 1.12).
+#if H5_VERSION_GE(1, 12, 0)
+herr_t collectDataset(hid_t, const char* name, const H5O_info2_t* info, void* out) {
+#else
+herr_t collectDataset(hid_t, const char* name, const H5O_info_t* info, void* out) {
+#endif
+  if (info->type == H5O_TYPE_DATASET) static_cast<std::vector<std::string>*>(out)->push_back(std::string("/") + name);
+  return 0;
+}
+}  // namespace
+
+std::vector<std::string> Hdf5File::datasets() const {
+  std::vector<std::string> names;
+#if H5_VERSION_GE(1, 12, 0)
+  const herr_t ok = H5Ovisit3(file_, H5_INDEX_NAME, H5_ITER_INC, collectDataset, &names, H5O_INFO_BASIC);
+#else
+  const herr_t ok = H5Ovisit2(file_, H5_INDEX_NAME, H5_ITER_INC, collectDataset, &names, H5O_INFO_BASIC);
+#endif
+  if (ok < 0) fail(path_, "list the datasets");
+  std::sort(names.begin(), names.end());
+  return names;
 }
 
 std::vector<std::size_t> Hdf5File::shape(const std::string& dataset) const {

@@ -40,6 +40,8 @@ class Hdf5File {
   std::vector<std::int64_t> readInts(const std::string& dataset, std::vector<std::size_t>* dims = nullptr) const;
   double readAttribute(const std::string& name) const;
   bool has(const std::string& dataset) const;
+  /// Every dataset of the file by its path ("/modules/fluid/U"), sorted.
+  std::vector<std::string> datasets() const;
   /// The shape of a dataset. Throws OutputError when absent.
   std::vector<std::size_t> shape(const std::string& dataset) const;
 

@@ -755,6 +755,75 @@ MembraneSolveReport MembraneSolver::solveStep(real dt) {
 }
 
 // ---------------------------------------------------------------------------------------------
+// Checkpoints
+// ---------------------------------------------------------------------------------------------
+
+void MembraneSolver::saveState(io::StateWriter& w) const {
+  w.putReal("time", time_);
+  w.putView("displacement", u_);
+  w.putView("velocity", v_);
+  w.putView("acceleration", a_);
+  w.putBool("haveAcceleration", haveAcceleration_);
+  // An uncommitted step: a repeated solveStep of the same dt starts Newton from its trial
+  // displacement (the trial velocity and acceleration follow from it and the committed state).
+  io::StateWriter trial = w.sub("trial");
+  trial.putBool("valid", trial_.valid);
+  trial.putReal("dt", trial_.dt);
+  if (trial_.valid) trial.putView("displacement", uTrial_);
+  io::StateWriter report = w.sub("lastReport");
+  report.putBool("converged", last_.converged);
+  report.putInt("iterations", last_.iterations);
+  report.putInt("linearIterations", last_.linearIterations);
+  report.putInt("lineSearchSteps", last_.lineSearchSteps);
+  report.putReal("relativeResidual", last_.relativeResidual);
+  report.putReal("seconds", last_.seconds);
+  io::StateWriter loads = w.sub("loads");
+  if (loads_.nodePressure.extent(0) > 0) loads.putView("nodePressure", loads_.nodePressure);
+  if (loads_.elementPressure.extent(0) > 0) loads.putView("elementPressure", loads_.elementPressure);
+  if (loads_.nodeForce.extent(0) > 0) loads.putView("nodeForce", loads_.nodeForce);
+}
+
+void MembraneSolver::loadState(const io::StateReader& r) {
+  // The displacement first: a checkpoint of another mesh fails before anything else changes.
+  r.getView("displacement", u_);
+  r.getView("velocity", v_);
+  r.getView("acceleration", a_);
+  time_ = r.real("time");
+  haveAcceleration_ = r.boolean("haveAcceleration");
+  const io::StateReader report = r.sub("lastReport");
+  last_.converged = report.boolean("converged");
+  last_.iterations = static_cast<int>(report.integer("iterations"));
+  last_.linearIterations = static_cast<int>(report.integer("linearIterations"));
+  last_.lineSearchSteps = static_cast<int>(report.integer("lineSearchSteps"));
+  last_.relativeResidual = report.real("relativeResidual");
+  last_.seconds = report.real("seconds");
+  const io::StateReader loads = r.sub("loads");
+  if (loads.has("nodePressure")) {
+    if (loads_.nodePressure.extent(0) == 0)
+      loads_.nodePressure = RealView("mfsi::structure::membrane::loads::nodePressure", mesh_.nNodes());
+    loads.getView("nodePressure", loads_.nodePressure);
+  }
+  if (loads.has("elementPressure")) {
+    if (loads_.elementPressure.extent(0) == 0)
+      loads_.elementPressure = RealView("mfsi::structure::membrane::loads::elementPressure", mesh_.nElements());
+    loads.getView("elementPressure", loads_.elementPressure);
+  }
+  if (loads.has("nodeForce")) {
+    if (loads_.nodeForce.extent(0) == 0)
+      loads_.nodeForce = Real3View("mfsi::structure::membrane::loads::nodeForce", mesh_.nNodes());
+    loads.getView("nodeForce", loads_.nodeForce);
+  }
+  const io::StateReader trial = r.sub("trial");
+  trial_.valid = trial.boolean("valid");
+  trial_.dt = trial.real("dt");
+  if (trial_.valid) {
+    trial.getView("displacement", uTrial_);
+    trialKinematics();
+    exec_.fence();
+  }
+}
+
+// ---------------------------------------------------------------------------------------------
 // Output
 // ---------------------------------------------------------------------------------------------
 

@@ -18,6 +18,7 @@
 /// \endcode
 ///
 /// State vectors are flat device Views with 3 entries per node (x, y, z).
+#include "core/io/Checkpoint.hpp"
 #include "structure/membrane/MembraneElements.hpp"
 #include "structure/membrane/MembraneLinearSolve.hpp"
 
@@ -105,6 +106,19 @@ class MembraneSolver {
   /// slackFraction (of the reference area), iterations and relativeResidual of the last solve, time.
   std::map<std::string, double> summary();
   const MembraneSolveReport& lastReport() const { return last_; }
+
+  // --- checkpoints ---------------------------------------------------------------------------
+  /// \brief Write what a later `step`, `solveStep` or `solveStatic` reads, so a solver built from
+  /// the same mesh, options and boundary continues bitwise after `loadState`: time, displacement,
+  /// velocity, acceleration (and whether it is set), the trial state of an uncommitted step (a warm
+  /// start), the last report, and the load fields it holds (nodePressure, elementPressure,
+  /// nodeForce). Not written: what the options or the boundary define (uniform pressure, time
+  /// functions, clamp frames) and what is recomputed from the state (mass, damping matrix).
+  void saveState(io::StateWriter& w) const;
+  /// \brief Read what `saveState` wrote. A load field in the checkpoint is copied into the View
+  /// the loads hold (a coupling that shares it gets it back) or into a new one. Throws InputError
+  /// naming the checkpoint and dataset when it does not fit (another mesh).
+  void loadState(const io::StateReader& r);
 
   // Building blocks, public for tests, benchmarks and coupling.
 

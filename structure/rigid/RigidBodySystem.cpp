@@ -18,6 +18,16 @@ Eigen::Vector3d rigidEulerAngles(const Eigen::Matrix3d& R) {
 namespace {
 /// Rotation angle of R in [0, pi].
 double rotationAngle(const Eigen::Matrix3d& R) { return std::acos(std::clamp(0.5 * (R.trace() - 1.0), -1.0, 1.0)); }
+
+std::vector<double> flat(const Eigen::VectorXd& v) { return std::vector<double>(v.data(), v.data() + v.size()); }
+Eigen::VectorXd vectorOf(const std::vector<double>& v) {
+  return Eigen::Map<const Eigen::VectorXd>(v.data(), static_cast<Eigen::Index>(v.size()));
+}
+void append(std::vector<double>& to, const Eigen::Vector3d& v) { to.insert(to.end(), {v[0], v[1], v[2]}); }
+/// The i-th triple of a flat list of 3-vectors.
+Eigen::Vector3d vector3At(const std::vector<double>& v, std::size_t i) {
+  return {v[3 * i], v[3 * i + 1], v[3 * i + 2]};
+}
 }  // namespace
 
 RigidBodySystem::RigidBodySystem(const RigidSystemOptions& options)
@@ -318,6 +328,110 @@ void RigidBodySystem::setState(const Eigen::VectorXd& q, const Eigen::VectorXd& 
   state0_.qdot = qdot;
   initialiseAcceleration();
   accelerationStale_ = true;
+}
+
+// --- checkpoints --------------------------------------------------------------------------------
+
+void RigidBodySystem::saveState(io::StateWriter& w) const {
+  auto putState = [](io::StateWriter sw, const State& st) {
+    sw.putReal("t", st.t);
+    sw.put("q", flat(st.q));
+    sw.put("qdot", flat(st.qdot));
+    sw.put("qddot", flat(st.qddot));
+  };
+  putState(w.sub("committed"), state0_);
+  putState(w.sub("latest"), state_);
+  w.putBool("pending", pending_);
+  w.putBool("accelerationStale", accelerationStale_);
+  w.putInt("steps", steps_);
+  w.putBool("lastConverged", lastConverged_);
+  w.putInt("lastIterations", lastIterations_);
+  w.putInt("maxIterationsUsed", maxIterationsUsed_);
+  w.put("generalisedForce", flat(tau_));
+  // Per body, 3 values each (body-major).
+  std::vector<std::int64_t> active;
+  std::vector<double> force, moment, point, loadForce, loadMoment, com, rotation;
+  for (int b = 0; b < model_.nBodies(); ++b) {
+    const ExternalLoad& e = external_[b];
+    active.push_back(e.active ? 1 : 0);
+    append(force, e.force);
+    append(moment, e.moment);
+    append(point, e.localPoint);
+    append(loadForce, loads_[b].force);
+    append(loadMoment, loads_[b].moment);
+    append(com, initialCom_[b]);
+    for (int i = 0; i < 3; ++i) append(rotation, initialRotation_[b].row(i).transpose());
+  }
+  io::StateWriter ext = w.sub("external");
+  ext.put("active", active);
+  ext.put("force", force);
+  ext.put("moment", moment);
+  ext.put("localPoint", point);
+  io::StateWriter reported = w.sub("reported");
+  reported.put("force", loadForce);
+  reported.put("moment", loadMoment);
+  reported.put("constraintTorque", flat(constraintTorque_));
+  w.put("initialCom", com);
+  w.put("initialRotation", rotation);
+  w.put("maxDisplacement", maxDisplacement_);
+  w.put("maxRotation", maxRotation_);
+}
+
+void RigidBodySystem::loadState(const io::StateReader& r) {
+  // Everything is read (and checked) before anything changes.
+  const int n = model_.nDof();
+  const std::size_t nB = static_cast<std::size_t>(model_.nBodies());
+  const long long n3 = 3 * static_cast<long long>(nB);
+  auto getState = [n](const io::StateReader& sr) {
+    State st;
+    st.t = sr.real("t");
+    st.q = vectorOf(sr.doubles("q", n));
+    st.qdot = vectorOf(sr.doubles("qdot", n));
+    st.qddot = vectorOf(sr.doubles("qddot", n));
+    return st;
+  };
+  const State committed = getState(r.sub("committed")), latest = getState(r.sub("latest"));
+  const Eigen::VectorXd tau = vectorOf(r.doubles("generalisedForce", n));
+  const io::StateReader ext = r.sub("external"), reported = r.sub("reported");
+  const std::vector<std::int64_t> active = ext.ints("active", static_cast<long long>(nB));
+  const std::vector<double> force = ext.doubles("force", n3), moment = ext.doubles("moment", n3),
+                            point = ext.doubles("localPoint", n3), loadForce = reported.doubles("force", n3),
+                            loadMoment = reported.doubles("moment", n3),
+                            torque = reported.doubles("constraintTorque", static_cast<long long>(constraints_.size())),
+                            com = r.doubles("initialCom", n3), rotation = r.doubles("initialRotation", 3 * n3),
+                            maxDisplacement = r.doubles("maxDisplacement", static_cast<long long>(nB)),
+                            maxRotation = r.doubles("maxRotation", static_cast<long long>(nB));
+  const bool pending = r.boolean("pending"), stale = r.boolean("accelerationStale"),
+             converged = r.boolean("lastConverged");
+  const long long steps = r.integer("steps"), lastIterations = r.integer("lastIterations"),
+                  maxIterations = r.integer("maxIterationsUsed");
+
+  state0_ = committed;
+  state_ = latest;
+  tau_ = tau;
+  for (std::size_t b = 0; b < nB; ++b) {
+    ExternalLoad& e = external_[b];
+    e.active = active[b] != 0;
+    e.force = vector3At(force, b);
+    e.moment = vector3At(moment, b);
+    e.localPoint = vector3At(point, b);
+    loads_[b].force = vector3At(loadForce, b);
+    loads_[b].moment = vector3At(loadMoment, b);
+    initialCom_[b] = vector3At(com, b);
+    for (int i = 0; i < 3; ++i) initialRotation_[b].row(i) = vector3At(rotation, 3 * b + i).transpose();
+  }
+  constraintTorque_ = vectorOf(torque);
+  maxDisplacement_ = maxDisplacement;
+  maxRotation_ = maxRotation;
+  pending_ = pending;
+  accelerationStale_ = stale;
+  lastConverged_ = converged;
+  steps_ = static_cast<long>(steps);
+  lastIterations_ = static_cast<int>(lastIterations);
+  maxIterationsUsed_ = static_cast<int>(maxIterations);
+  // The kinematics are a function of the latest state alone; the reported loads are not (they are
+  // those of the solve, while the external loads may have been replaced since), hence saved.
+  model_.kinematics(state_.t, state_.q, state_.qdot, state_.qddot, kin_);
 }
 
 // --- reporting --------------------------------------------------------------------------------

@@ -15,6 +15,7 @@
 ///   qdot1 = qdot0 + d dt ((1 - gamma) a0 + gamma a1)
 ///   M(q1) a1 = Q(t1, q1, qdot1)      solved for a1 by Newton (FD Jacobian) or fixed point,
 /// then a1 <- r a1 + (1 - r) a_prev (r = accelerationRelaxation) and q1, qdot1 are recomputed.
+#include "core/io/Checkpoint.hpp"
 #include "structure/rigid/RigidBodyModel.hpp"
 #include "structure/rigid/RigidOptions.hpp"
 #include "structure/rigid/RigidRestraint.hpp"
@@ -107,6 +108,18 @@ class RigidBodySystem {
   const RigidTreeKinematics& kinematics() const { return kin_; }
   /// \brief Joint-space mass matrix at the latest state.
   Eigen::MatrixXd massMatrix() const;
+
+  // --- checkpoints ---------------------------------------------------------------------------
+  /// \brief Write everything a later step and the reports read, so a system built from the same
+  /// options continues bitwise after `loadState`: the committed and the latest state (t, q, qdot,
+  /// qddot; the latest one is the start iterate of the next solve), whether a solve awaits its
+  /// commit or a0 must be recomputed, external loads and generalised forces, the reported body
+  /// loads and motor torques, the start pose, the running maxima and the iteration counters. The
+  /// restraints and the model hold no state; the kinematics are recomputed from the latest state.
+  void saveState(io::StateWriter& w) const;
+  /// \brief Read what `saveState` wrote. Throws InputError naming the checkpoint and dataset when it
+  /// does not fit (another number of bodies, coordinates or prescribed rotations).
+  void loadState(const io::StateReader& r);
 
   // --- energies and summary -------------------------------------------------------------------
   /// \brief sum 1/2 m v_CoM^2 + 1/2 omega . I omega (includes prescribed motion).

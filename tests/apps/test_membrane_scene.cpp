@@ -3,6 +3,7 @@
 //  - two panels in one scene are two modules with their own materials (w0 ~ E^(-1/3));
 //  - bad input names file:line and the key;
 //  - a membrane-only scene builds membrane modules only and allocates no fluid or mesh data.
+#include "support/TextFiles.hpp"
 #include "support/AllocationRecorder.hpp"
 #include "support/Approx.hpp"
 
@@ -21,13 +22,7 @@ using mfsi::test::Tol;
 
 namespace {
 
-std::string readFile(const std::string& path) {
-  std::ifstream in(path);
-  EXPECT_TRUE(in.good()) << "cannot open " << path;
-  std::stringstream s;
-  s << in.rdbuf();
-  return s.str();
-}
+using mfsi::test::readFile;
 
 mfsi::RunResult runScene(const std::string& yaml, const std::string& file, const std::string& out) {
   auto cfg = mfsi::SceneConfig::fromString(yaml, file, mfsi::sceneSchema());

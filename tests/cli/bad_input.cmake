@@ -55,6 +55,21 @@ if(NOT rc EQUAL 2)
   message(SEND_ERROR "check of a bad scene: exit code ${rc}, expected 2")
 endif()
 
+# check refuses what run refuses, and an absurd mesh at once (nothing allocated); the README's
+# one-block override of the two-block box names both blocks.
+execute_process(COMMAND ${MFSI} check ${DATA}/scenes/huge_cells.yaml RESULT_VARIABLE rc ERROR_VARIABLE e OUTPUT_QUIET
+  TIMEOUT 20)
+string(FIND "${e}" "key 'mesh.blocks.0.cells'" pos)
+if(NOT rc EQUAL 2 OR pos EQUAL -1)
+  message(SEND_ERROR "check of 10^15 cells: exit ${rc}, expected 2 and the key mesh.blocks.0.cells: ${e}")
+endif()
+execute_process(COMMAND ${MFSI} check ${CASES}/box.yaml --set mesh.blocks.0.cells=[32,32,8]
+  RESULT_VARIABLE rc ERROR_VARIABLE e OUTPUT_QUIET)
+string(FIND "${e}" "mesh.blocks.0 face +x and mesh.blocks.1 face -x touch but their grids differ" pos)
+if(NOT rc EQUAL 2 OR pos EQUAL -1)
+  message(SEND_ERROR "check of mismatched blocks: exit ${rc}, expected 2 and both blocks named: ${e}")
+endif()
+
 # A scene that is not a regular file: a FIFO would block the reader forever, /dev/zero never ends.
 execute_process(COMMAND mkfifo ${WORK}/scene.fifo RESULT_VARIABLE rc)
 if(rc EQUAL 0)

@@ -9,13 +9,16 @@
 #include "core/MeshGeometry.hpp"
 #include "core/PolyMeshReader.hpp"
 #include "support/Approx.hpp"
+#include "support/FreshDir.hpp"
 
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <filesystem>
 #include <fstream>
 #include <functional>
 #include <string>
+#include <utility>
 #include <vector>
 
 using mfsi::test::near;
@@ -325,5 +328,86 @@ TEST(PolyMeshReader, BadMeshesNameFileAndDefect) {
   {
     const std::string d = meshPath("no_such.polyMesh");
     EXPECT_HAS(errorOf([&] { mfsi::readPolyMesh(d); }), d + "/points: cannot open");
+  }
+}
+
+// Corrupt sizes and labels in a copy of box.polyMesh: each must name the file, the line and the
+// entry instead of sizing arrays from them (a label of 2e9 used to allocate 8 GB, a list size of
+// 2e9 to reserve 48 GB).
+namespace {
+
+/// A copy of box.polyMesh in a scratch folder, with lines of file `name` replaced: {1-based line, text}.
+std::string corruptedBox(const std::string& tag, const std::string& name,
+                         const std::vector<std::pair<int, std::string>>& edits) {
+  const std::string dir = mfsi::test::freshDir("polymesh_" + tag);
+  for (const auto& e : std::filesystem::directory_iterator(meshPath("box.polyMesh")))
+    std::filesystem::copy_file(e.path(), dir + "/" + e.path().filename().string());
+  std::vector<std::string> lines;
+  {
+    std::ifstream in(dir + "/" + name);
+    for (std::string l; std::getline(in, l);) lines.push_back(l);
+  }
+  for (const auto& [line, text] : edits) {
+    EXPECT_TRUE(line >= 1 && line <= static_cast<int>(lines.size())) << name << ":" << line;
+    if (line >= 1 && line <= static_cast<int>(lines.size())) lines[line - 1] = text;
+  }
+  std::ofstream out(dir + "/" + name);
+  for (const auto& l : lines) out << l << "\n";
+  return dir;
+}
+
+/// 1-based line of the first entry of the list of `path` (the line after its "(").
+int firstEntryLine(const std::string& path) { return lineStartingWith(path, "(") + 1; }
+
+}  // namespace
+
+TEST(PolyMeshReader, HugeLabelsAndSizesAreRefusedBeforeAllocating) {
+  const std::string owner = meshPath("box.polyMesh/owner");
+  const int entry5 = firstEntryLine(owner) + 5;
+  {
+    const std::string d = corruptedBox("owner_label", "owner", {{entry5, "2000000000"}});
+    EXPECT_HAS(errorOf([&] { mfsi::readPolyMesh(d); }),
+               d + "/owner:" + std::to_string(entry5) +
+                   ": entry 5: cell label 2000000000 is out of range [0, 16): the header's note gives nCells 16");
+  }
+  {
+    // Without the header's note, the faces bound the cells: 68 faces, at most 34 cells.
+    const int note = lineStartingWith(owner, "    note");
+    ASSERT_GT(note, 0);
+    const std::string d = corruptedBox("owner_label_no_note", "owner", {{note, ""}, {entry5, "2147483647"}});
+    EXPECT_HAS(
+        errorOf([&] { mfsi::readPolyMesh(d); }),
+        d + "/owner:" + std::to_string(entry5) +
+            ": entry 5: cell label 2147483647 is out of range [0, 34): the mesh has 68 faces, so at most 34 cells");
+  }
+  {
+    const std::string neighbour = meshPath("box.polyMesh/neighbour");
+    const int first = firstEntryLine(neighbour);
+    const std::string d = corruptedBox("neighbour_label", "neighbour", {{first, "-7"}});
+    EXPECT_HAS(errorOf([&] { mfsi::readPolyMesh(d); }),
+               d + "/neighbour:" + std::to_string(first) + ": entry 0: cell label -7 is out of range [0, 16)");
+  }
+  {
+    const std::string points = meshPath("box.polyMesh/points");
+    const int size = firstEntryLine(points) - 2;
+    const std::string d = corruptedBox("points_size", "points", {{size, "2000000000"}});
+    const std::string msg = errorOf([&] { mfsi::readPolyMesh(d); });
+    EXPECT_HAS(msg, d + "/points:" + std::to_string(size) +
+                        ": the points list announces 2000000000 entries, but the rest "
+                        "of the file (");
+    EXPECT_HAS(msg, "bytes) holds at most ");
+  }
+  {
+    const int size = firstEntryLine(owner) - 2;
+    const std::string d = corruptedBox("owner_size", "owner", {{size, "-3"}});
+    EXPECT_HAS(
+        errorOf([&] { mfsi::readPolyMesh(d); }),
+        d + "/owner:" + std::to_string(size) + ": the owner list announces -3 entries, but a size cannot be negative");
+  }
+  {
+    const std::string boundary = meshPath("box.polyMesh/boundary");
+    const int nFaces = lineStartingWith(boundary, "        nFaces");
+    const std::string d = corruptedBox("boundary_size", "boundary", {{nFaces, "        nFaces 9223372036854775807;"}});
+    EXPECT_HAS(errorOf([&] { mfsi::readPolyMesh(d); }), "nFaces 9223372036854775807) runs past the 68 faces");
   }
 }

@@ -1,0 +1,114 @@
+// SIGINT and SIGTERM stop `mfsi run` cleanly (issue 14): after the step in progress the run writes
+// a checkpoint, steps.csv up to that step and a summary with status "interrupted", and exits with
+// 128 + the signal; `mfsi run --restart` then finishes it, and the whole steps.csv equals an
+// uninterrupted run's (but the wall time).
+#include "support/CubeCavity.hpp"
+#include "support/FreshDir.hpp"
+#include "support/TextFiles.hpp"
+
+#include <gtest/gtest.h>
+
+#include <fcntl.h>
+#include <spawn.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <chrono>
+#include <csignal>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+#include <string>
+#include <thread>
+#include <vector>
+
+extern char** environ;
+
+namespace {
+
+const std::string kScene = mfsi::test::cubeCavityScene(14, 8);
+
+pid_t start(const std::vector<std::string>& args, const std::string& log) {
+  std::vector<std::string> all = {MFSI_EXE};
+  all.insert(all.end(), args.begin(), args.end());
+  std::vector<char*> argv;
+  for (auto& a : all) argv.push_back(a.data());
+  argv.push_back(nullptr);
+  posix_spawn_file_actions_t actions;
+  posix_spawn_file_actions_init(&actions);
+  posix_spawn_file_actions_addopen(&actions, 1, log.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
+  posix_spawn_file_actions_adddup2(&actions, 1, 2);
+  pid_t pid = -1;
+  const int rc = posix_spawn(&pid, MFSI_EXE, &actions, nullptr, argv.data(), environ);
+  posix_spawn_file_actions_destroy(&actions);
+  return rc == 0 ? pid : -1;
+}
+
+int finish(pid_t pid) {
+  int status = 0;
+  waitpid(pid, &status, 0);
+  return WIFEXITED(status) ? WEXITSTATUS(status) : 1000 + WTERMSIG(status);
+}
+
+/// The file's text, "" while it does not exist (polled while the run starts).
+std::string read(const std::string& file) {
+  if (!std::filesystem::exists(file)) return "";
+  return mfsi::test::readFile(file);
+}
+
+long rows(const std::string& csv) {
+  const std::string s = read(csv);
+  long n = 0;
+  for (char c : s) n += c == '\n';
+  return n - 1;
+}
+
+std::string withoutWall(const std::string& csv) {
+  std::stringstream in(read(csv));
+  std::string line, out;
+  while (std::getline(in, line)) {
+    std::stringstream ls(line);
+    int i = 0;
+    for (std::string c; std::getline(ls, c, ','); ++i)
+      if (i != 2) out += c + ",";
+    out += "\n";
+  }
+  return out;
+}
+
+void interruptAndContinue(int signal, const std::string& tag) {
+  const std::string dir = mfsi::test::freshDir("interrupt_" + tag);
+  const std::string scene = dir + "/scene_in.yaml";
+  std::ofstream(scene) << kScene;
+  const std::string whole = dir + "/whole", run = dir + "/run";
+  ASSERT_EQ(finish(start({"run", scene, "--out", whole}, dir + "/whole.log")), 0) << read(dir + "/whole.log");
+
+  const pid_t pid = start({"run", scene, "--out", run}, dir + "/run.log");
+  ASSERT_GT(pid, 0);
+  // Let it take a few steps, then stop it.
+  for (int i = 0; i < 600 && rows(run + "/steps.csv") < 5; ++i) std::this_thread::sleep_for(std::chrono::milliseconds(50));
+  ASSERT_GE(rows(run + "/steps.csv"), 5) << read(dir + "/run.log");
+  kill(pid, signal);
+  ASSERT_EQ(finish(pid), 128 + signal) << read(dir + "/run.log");
+  const long done = rows(run + "/steps.csv");
+  ASSERT_LT(done, 400) << "the run finished before the signal: nothing was tested";
+  const std::string summary = read(run + "/summary.json");
+  EXPECT_NE(summary.find("\"status\": \"interrupted\""), std::string::npos) << summary;
+  EXPECT_NE(summary.find("\"steps\": " + std::to_string(done)), std::string::npos) << summary;
+  char name[64];
+  std::snprintf(name, sizeof name, "/checkpoints/checkpoint_%09ld.h5", done);
+  EXPECT_TRUE(std::filesystem::exists(run + name)) << run + name;
+  EXPECT_NE(read(dir + "/run.log").find("--restart"), std::string::npos);
+
+  // Continue in place to the end: the same steps as the uninterrupted run.
+  ASSERT_EQ(finish(start({"run", "--restart", run}, dir + "/restart.log")), 0) << read(dir + "/restart.log");
+  EXPECT_NE(read(run + "/summary.json").find("\"status\": \"ok\""), std::string::npos);
+  EXPECT_EQ(rows(run + "/steps.csv"), 400);
+  EXPECT_EQ(withoutWall(run + "/steps.csv"), withoutWall(whole + "/steps.csv"));
+}
+
+}  // namespace
+
+TEST(Interrupt, SigintStopsWithACheckpointAndTheRestartFinishesTheRun) { interruptAndContinue(SIGINT, "int"); }
+
+TEST(Interrupt, SigtermStopsWithACheckpointAndTheRestartFinishesTheRun) { interruptAndContinue(SIGTERM, "term"); }

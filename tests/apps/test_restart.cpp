@@ -1,0 +1,169 @@
+// Checkpoint and restart (issue 14): a run of 2N steps and a run of N steps continued from its
+// checkpoint for N more end in the same state, bit for bit — every dataset of their step-2N
+// checkpoints (fields, old time levels, solver guesses, preconditioner history, structure and
+// coupling state) and every column of steps.csv but the wall time.
+#include "coupling/Simulation.hpp"
+#include "core/Error.hpp"
+#include "core/io/Hdf5File.hpp"
+
+#include "support/CubeCavity.hpp"
+#include "support/FreshDir.hpp"
+
+#include <gtest/gtest.h>
+
+#include <cstring>
+#include <fstream>
+#include <sstream>
+#include <string>
+#include <vector>
+
+using mfsi::io::Hdf5File;
+
+namespace {
+
+const std::string kCavity3d = mfsi::test::cubeCavityScene(12, 10);
+
+mfsi::SceneConfig scene(const std::string& source, std::vector<std::string> sets) {
+  if (source.find('\n') != std::string::npos)
+    return mfsi::SceneConfig::fromString(source, "inline.yaml", mfsi::sceneSchema(), sets);
+  return mfsi::SceneConfig::load(std::string(MFSI_CASES_DIR) + "/" + source + ".yaml", mfsi::sceneSchema(), sets);
+}
+
+std::vector<std::string> with(std::vector<std::string> sets, std::initializer_list<std::string> more) {
+  sets.insert(sets.end(), more);
+  return sets;
+}
+
+/// Wall-clock measurements (a solve's seconds, a phase's time and share): the only values a
+/// restarted run may differ in.
+bool isTiming(const std::string& name) {
+  const auto ends = [&](const std::string& e) {
+    return name.size() >= e.size() && name.compare(name.size() - e.size(), e.size(), e) == 0;
+  };
+  return ends("/seconds") || ends("_s") || name.find(".share_") != std::string::npos;
+}
+
+/// steps.csv without its wall-time column.
+std::string stepsWithoutWall(const std::string& file) {
+  std::ifstream in(file);
+  std::string line, out;
+  while (std::getline(in, line)) {
+    std::vector<std::string> cells;
+    std::stringstream ls(line);
+    for (std::string c; std::getline(ls, c, ',');) cells.push_back(c);
+    for (std::size_t i = 0; i < cells.size(); ++i)
+      if (i != 2) out += cells[i] + ",";
+    out += "\n";
+  }
+  return out;
+}
+
+/// Every dataset of two checkpoints holds the same bits (the wall time, /run/time[4], aside).
+void expectSameCheckpoints(const std::string& a, const std::string& b) {
+  const Hdf5File fa = Hdf5File::openRead(a), fb = Hdf5File::openRead(b);
+  const auto names = fa.datasets();
+  ASSERT_EQ(names, fb.datasets());
+  ASSERT_GT(names.size(), 10u);
+  int compared = 0;
+  for (const auto& n : names) {
+    if (isTiming(n)) continue;
+    std::vector<std::size_t> da, db;
+    const auto ia = fa.readInts(n, &da), ib = fb.readInts(n, &db);  // exact for integer datasets
+    ASSERT_EQ(da, db) << n;
+    auto xa = fa.readDoubles(n), xb = fb.readDoubles(n);
+    if (n == "/run/time") xa.resize(4), xb.resize(4);
+    ASSERT_EQ(xa.size(), xb.size()) << n;
+    std::size_t differ = 0, first = 0;
+    for (std::size_t i = 0; i < xa.size(); ++i)
+      if (std::memcmp(&xa[i], &xb[i], sizeof(double)) != 0 && differ++ == 0) first = i;
+    EXPECT_EQ(differ, 0u) << n << ": " << differ << " of " << xa.size() << " values differ, the first at " << first
+                          << " (" << xa[first] << " against " << xb[first] << ")";
+    EXPECT_EQ(ia == ib || n == "/run/time", true) << n;
+    ++compared;
+  }
+  EXPECT_GT(compared, static_cast<int>(names.size()) * 9 / 10);
+}
+
+/// 2N steps in one run against N steps, restart, N steps (continuing the first folder).
+void expectRestartIsBitwise(const std::string& tag, const std::string& source, const std::vector<std::string>& sets,
+                            int n) {
+  const std::string whole = mfsi::test::freshDir("restart_" + tag + "_whole");
+  const std::string split = mfsi::test::freshDir("restart_" + tag + "_split");
+  const std::string ck = "output.checkpoint.final=true";
+  mfsi::RunResult a;
+  {
+    mfsi::Simulation sim(scene(source, with(sets, {"time.maxSteps=" + std::to_string(2 * n), ck})));
+    a = sim.run(whole, false);
+  }
+  ASSERT_EQ(a.steps, 2 * n);
+  {
+    mfsi::Simulation sim(scene(source, with(sets, {"time.maxSteps=" + std::to_string(n), ck})));
+    ASSERT_EQ(sim.run(split, false).steps, n);
+  }
+  mfsi::RunResult b;
+  {
+    mfsi::Simulation sim(scene(source, with(sets, {"time.maxSteps=" + std::to_string(2 * n), ck})));
+    const std::string checkpoint = mfsi::Simulation::findCheckpoint(split);
+    char name[64];
+    std::snprintf(name, sizeof name, "checkpoint_%09d.h5", n);
+    EXPECT_EQ(std::filesystem::path(checkpoint).filename().string(), name);
+    sim.restore(checkpoint);
+    EXPECT_EQ(sim.completedSteps(), n);
+    b = sim.run(split, false, /*continueFiles=*/true);
+  }
+  ASSERT_EQ(b.steps, 2 * n);
+  char last[64];
+  std::snprintf(last, sizeof last, "/checkpoints/checkpoint_%09d.h5", 2 * n);
+  expectSameCheckpoints(whole + last, split + last);
+  EXPECT_EQ(stepsWithoutWall(whole + "/steps.csv"), stepsWithoutWall(split + "/steps.csv"));
+  for (const auto& [key, value] : a.metrics) {
+    ASSERT_TRUE(b.metrics.count(key)) << key;
+    if (isTiming(key)) continue;
+    EXPECT_EQ(std::memcmp(&value, &b.metrics.at(key), sizeof(double)), 0) << key << ": " << value << " against "
+                                                                           << b.metrics.at(key);
+  }
+}
+
+}  // namespace
+
+TEST(Restart, TheTransientCubeCavityContinuesBitwise) {
+  expectRestartIsBitwise("cavity3d", kCavity3d, {}, 10);
+}
+
+TEST(Restart, AChangedSceneIsRefusedWithWhatChanged) {
+  const std::string dir = mfsi::test::freshDir("restart_changed");
+  {
+    mfsi::Simulation sim(scene(kCavity3d, {"time.maxSteps=2", "output.checkpoint.final=true"}));
+    sim.run(dir, false);
+  }
+  mfsi::Simulation changed(scene(kCavity3d, {"fluid.nu=0.02", "time.maxSteps=4"}));
+  try {
+    changed.restore(mfsi::Simulation::findCheckpoint(dir));
+    FAIL() << "a restart with another viscosity was accepted";
+  } catch (const mfsi::InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("fluid.nu: 0.01 -> 0.02"), std::string::npos) << e.what();
+  }
+  // What a restart may change: the end and the output.
+  mfsi::Simulation longer(scene(kCavity3d, {"time.maxSteps=4", "output.fields.everySteps=1"}));
+  EXPECT_NO_THROW(longer.restore(mfsi::Simulation::findCheckpoint(dir)));
+  EXPECT_EQ(longer.completedSteps(), 2);
+}
+
+TEST(Restart, TheMembraneSquaresDynamicsContinueBitwise) {
+  expectRestartIsBitwise("membrane_square", "membrane-square", {"membranes.0.mesh.rectangle.cells=[6,6]"}, 6);
+}
+
+TEST(Restart, TheDoublePendulumContinuesBitwise) {
+  expectRestartIsBitwise("double_pendulum", "double-pendulum", {}, 40);
+}
+
+// FSI with IQN-ILS whose columns are reused across steps: the restarted run must carry them.
+TEST(Restart, TheFlexibleCavityWithIqnIlsReuseContinuesBitwise) {
+  expectRestartIsBitwise("flexible_cavity", "flexible-cavity",
+                         {"mesh.blocks.0.cells=[12,10,1]", "mesh.blocks.1.cells=[12,2,1]"}, 4);
+}
+
+// A membrane mounted on a sprung rigid frame in a 3D channel: fluid, membrane, bodies and coupling.
+TEST(Restart, TheMembraneChannelContinuesBitwise) {
+  expectRestartIsBitwise("membrane_channel", "membrane-channel", {"mesh.blocks.0.cells=[24,8,16]"}, 2);
+}
