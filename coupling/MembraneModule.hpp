@@ -28,7 +28,8 @@ class MembraneModule final : public Module {
   void saveState(io::StateWriter& w) const override;
   void loadState(const io::StateReader& r) override;
   /// "<name>.<summary key>" for every entry of MembraneSolver::summary(), and the comparison with
-  /// the reference solution: hencky_w0 and hencky_rel_err, or period, period_exact and period_rel_err.
+  /// the reference solution: hencky_w0 (computed), hencky_w0_exact and hencky_rel_err, or period, period_exact and
+  /// period_rel_err.
   void addMetrics(std::map<std::string, double>& metrics) const override;
   /// A grid of its own: the deformed surface (reference + displacement), displacement and velocity
   /// per node; per element the in-plane Green-Lagrange strain and PK2 stress (E11, E22, E12 and

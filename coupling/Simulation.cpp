@@ -328,6 +328,7 @@ std::string Simulation::runFolderOf(const std::string& checkpointFile) {
 }
 
 void Simulation::restore(const std::string& checkpointFile) {
+  ScopedTimer timer(timers_, "restore");
   io::Hdf5File file = [&] {
     try {
       return io::Hdf5File::openRead(checkpointFile);

@@ -1,5 +1,7 @@
 #include "structure/membrane/MembraneConfig.hpp"
 
+#include "structure/membrane/HenckySolution.hpp"
+
 #include "core/Suggest.hpp"
 #include "structure/membrane/MembraneMeshImport.hpp"
 
@@ -524,15 +526,7 @@ std::vector<MembranePanelOptions> readMembraneOptions(const SceneConfig& membran
   return panels;
 }
 
-double henckyCoefficient(double nu) {
-  // Hencky (1915) as corrected by Chien (1948), C_w at nu = 0, 0.1, ..., 0.5 (tests/data/hencky_coefficients.csv).
-  static const double table[6] = {0.7184, 0.6989, 0.6775, 0.6535, 0.6263, 0.5949};
-  MFSI_CHECK(nu >= 0 && nu <= 0.5, "Hencky coefficient: nu must be in [0, 0.5], got " << nu);
-  const double x = nu / 0.1;
-  const int i = std::min(4, static_cast<int>(std::floor(x)));
-  const double w = x - i;
-  return (1 - w) * table[i] + w * table[i + 1];
-}
+double henckyCoefficient(double nu) { return henckySolution(nu).deflection; }
 
 double rectangleMembraneFrequency(double T0, double rhoH, double lx, double ly, int m, int n) {
   return 0.5 * std::sqrt(T0 / rhoH) * std::sqrt((m / lx) * (m / lx) + (n / ly) * (n / ly));

@@ -140,8 +140,8 @@ Schema membraneSchema();
 std::vector<MembranePanelOptions> readMembraneOptions(const SceneConfig& membranes,
                                                       const HexMesh* fluidMesh = nullptr);
 
-/// \brief Hencky's coefficient C_w(nu) of w0 = C_w a (p a / (E h))^(1/3) (Hencky 1915 / Chien 1948,
-/// tabulated at nu = 0, 0.1, ..., 0.5; linear interpolation in between). Throws InputError outside [0, 0.5].
+/// \brief Hencky's coefficient C_w(nu) of w0 = C_w a (p a / (E h))^(1/3), exact for any nu in
+/// (-1, 0.5] (structure/membrane/HenckySolution.hpp). Throws InputError outside.
 double henckyCoefficient(double nu);
 
 /// \brief Exact f_mn (Hz) of a clamped rectangle lx x ly under isotropic tension T0 (N/m) with areal
