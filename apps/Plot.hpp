@@ -11,5 +11,6 @@
 /// The interpreter is the first that can import matplotlib of: $MFSI_PLOT_PYTHON when set (then
 /// the only one tried), the one CMake found at configure time, /usr/bin/python3, python3 on PATH.
 /// \return 0 ok; 2 bad input (not a run folder, nothing to plot) or no interpreter with
-/// matplotlib; 4 a picture could not be written; 1 the script could not run or failed.
+/// matplotlib; 4 a picture could not be written; 1 the script could not run or failed; 128 + N
+/// the script was ended by signal N.
 int commandPlot(const std::string& runDir, const std::string& outDir);

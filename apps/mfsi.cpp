@@ -8,15 +8,18 @@
 //   mfsi check --describe                     # every scene key with type, default, units, doc
 //   mfsi scenes                               # built-in scenes
 //   mfsi plot /tmp/box [--out DIR]            # PNGs of a run's time series (and a 2D field) in /tmp/box/plots/
+//   mfsi study cavity --vary mesh.refine=0.5,1,2 --metric fluid.ghia_u_max_err --reference 0   # error vs cost
 //   mfsi --version
 //
 // Exit codes: 0 ok, 2 bad input (scene, mesh, command line), 3 diverged, 4 results could not be
-// saved (a failed write), 1 internal error, 130 / 143 stopped by SIGINT / SIGTERM (after a
+// saved (a failed write, a full disk: summary.json says status "error", or there is none when it
+// could not be written itself), 1 internal error, 130 / 143 stopped by SIGINT / SIGTERM (after a
 // checkpoint: continue with --restart).
 // Every `run` writes <out>/summary.json (also on errors), <out>/scene.yaml and <out>/steps.csv (and
 // fields.xdmf with fields/ as the scene's `output` asks); a folder that holds an earlier run's
 // results is refused (exit 2, nothing written) unless --overwrite.
 #include "Plot.hpp"
+#include "Study.hpp"
 #include "coupling/Simulation.hpp"
 #include "core/Interrupt.hpp"
 #include "core/RunLog.hpp"
@@ -105,7 +108,8 @@ int commandCheck(const std::string& scene, const std::vector<std::string>& sets,
 }
 
 /// What a run writes into its output folder (files, and the folder of field frames).
-const char* const kRunOutputs[] = {"summary.json", "scene.yaml", "steps.csv", "bodies.csv", "fields.xdmf", "fields"};
+const char* const kRunOutputs[] = {"summary.json", "scene.yaml", "steps.csv",  "bodies.csv",
+                                   "fields.xdmf",  "fields",     "checkpoints", "plots"};
 
 /// Make `out` ready for a run before anything is built: a folder that holds another run's results
 /// is refused unless `overwrite` (which removes exactly those results, nothing else of the
@@ -254,8 +258,12 @@ int commandRun(std::string sceneArg, const std::vector<std::string>& sets, std::
       std::cout << (code == 0 ? "done" : summary.status == "interrupted" ? "interrupted" : "failed") << " in " << summary.wallSeconds << " s; results in " << out
                 << "/ (summary.json)\n";
     } catch (const std::exception& e) {
-      std::cerr << "error: cannot write the summary: " << e.what() << "\n";
-      if (code == 0) code = 2;
+      // No summary rather than a stale one (a continued run's earlier summary): a run without
+      // summary.json did not finish. The exit code keeps the run's own failure, else 4.
+      std::error_code ec;
+      fs::remove(fs::path(out) / "summary.json", ec);
+      std::cerr << "error: results not saved: cannot write the summary: " << e.what() << "\n";
+      if (code == 0) code = 4;
     }
   }
   return code;
@@ -276,7 +284,8 @@ int main(int argc, char** argv) {
 
   auto* run = app.add_subcommand("run", "run a scene (default: the built-in default scene)");
   run->add_option("scene", scene, "scene file, or the name of a built-in scene");
-  run->add_option("--set", sets, "override a scene value: --set a.b.c=value (repeatable)");
+  // Each --set takes one value (repeat it for more), so a scene after it stays the scene.
+  run->add_option("--set", sets, "override a scene value: --set a.b.c=value (repeatable)")->allow_extra_args(false);
   run->add_option("--out", out, "output folder (default: results/<scene>)");
   run->add_flag("--overwrite", overwrite, "replace the results of an earlier run in the output folder");
   run->add_option("--restart", restart,
@@ -286,7 +295,7 @@ int main(int argc, char** argv) {
 
   auto* check = app.add_subcommand("check", "validate a scene without running it");
   check->add_option("scene", scene, "scene file, or the name of a built-in scene");
-  check->add_option("--set", sets, "override a scene value: --set a.b.c=value (repeatable)");
+  check->add_option("--set", sets, "override a scene value: --set a.b.c=value (repeatable)")->allow_extra_args(false);
   check->add_flag("--describe", describe, "list every scene key with type, default, units and doc");
 
   app.add_subcommand("scenes", "list the built-in scenes");
@@ -296,11 +305,46 @@ int main(int argc, char** argv) {
   plot->add_option("run_dir", plotDir, "a folder written by `mfsi run`")->required();
   plot->add_option("--out", plotOut, "folder for the PNGs (default: RUN_DIR/plots)");
 
+  StudyOptions studyOptions;
+  auto* study =
+      app.add_subcommand("study",
+                         "run a scene over a grid of settings: study.csv, error against wall time (Pareto front) and "
+                         "against resolution (observed order); an interrupted study continues where it stopped");
+  study->add_option("scene", studyOptions.scene, "scene file, or the name of a built-in scene");
+  study
+      ->add_option("--vary", studyOptions.vary,
+                   "KEY=V1,V2,... values of a scene key (commas inside [..] belong to a value; K1+K2=... sets "
+                   "both; VALUE@LEVEL gives a named value a resolution); repeat for the product grid")
+      ->allow_extra_args(false);
+  study->add_option("--set", studyOptions.sets, "KEY=VALUE for every run (repeatable)")->allow_extra_args(false);
+  study->add_option("--metric", studyOptions.metric, "the metric of summary.json to compare");
+  study->add_option("--reference", studyOptions.reference,
+                    "exact (the metric's <NAME>_exact), exact:METRIC, finest (the finest run; Richardson "
+                    "estimate of the limit) or a number");
+  study->add_option("--jobs", studyOptions.jobs, "runs at once (default 1)")->check(CLI::PositiveNumber);
+  study
+      ->add_option("--threads", studyOptions.threads,
+                   "threads of the whole study, split between the jobs (default: OMP_NUM_THREADS or all cores)")
+      ->check(CLI::PositiveNumber);
+  study->add_option("--out", studyOptions.out, "study folder (default: results/<scene>-study)");
+  study->add_flag("--self-test", studyOptions.selfTest, "check the study's fits on synthetic data, then exit");
+
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
     // --help and --version exit 0; a command-line error is bad input: exit 2 like any other.
     return app.exit(e) == 0 ? 0 : 2;
+  }
+
+  // A study only starts `mfsi run` processes: no MPI or Kokkos of its own.
+  if (app.got_subcommand("study")) {
+    if (!studyOptions.selfTest && (studyOptions.scene.empty() || studyOptions.vary.empty() ||
+                                   studyOptions.metric.empty() || studyOptions.reference.empty())) {
+      std::cerr << "error: mfsi study needs SCENE, --vary KEY=V1,V2,..., --metric NAME and --reference "
+                   "exact|exact:METRIC|finest|VALUE (see mfsi study --help)\n";
+      return 2;
+    }
+    return commandStudy(studyOptions);
   }
 
   MPI_Init(&argc, &argv);

@@ -172,6 +172,28 @@ std::optional<BlockMismatch> findMismatchedContact(const BlockMeshSpec& spec) {
   return std::nullopt;
 }
 
+void refineBlocks(BlockMeshSpec& spec, real factor) {
+  if (!(factor > 0) || !std::isfinite(factor))
+    throw InputError("the refinement factor must be a positive number, not " + std::to_string(factor));
+  std::array<bool, 3> flat{true, true, true};  // one cell in every block: a 2D scene's thickness
+  for (const auto& b : spec.blocks)
+    for (int d = 0; d < 3; ++d) flat[d] = flat[d] && b.cells[d] == 1;
+  for (std::size_t i = 0; i < spec.blocks.size(); ++i) {
+    auto& cells = spec.blocks[i].cells;
+    for (int d = 0; d < 3; ++d) {
+      if (flat[d]) continue;
+      const double n = std::round(cells[d] * factor);
+      if (n > std::numeric_limits<int>::max()) {
+        std::ostringstream os;
+        os << "refining block " << i << " by " << factor << " gives " << n << " cells in one direction, more than "
+           << std::numeric_limits<int>::max();
+        throw InputError(os.str());
+      }
+      cells[d] = std::max(1, static_cast<int>(n));
+    }
+  }
+}
+
 BlockMeshSpec boxSpec(std::array<real, 3> min, std::array<real, 3> max, std::array<int, 3> cells) {
   BlockMeshSpec s;
   BlockSpec b;

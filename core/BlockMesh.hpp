@@ -97,6 +97,14 @@ std::optional<BlockMismatch> findMismatchedContact(const BlockMeshSpec& spec);
 /// select no face).
 HexMeshInput generateBlockMesh(const BlockMeshSpec& spec);
 
+/// \brief Multiply every block's cell counts by `factor` (rounded to the nearest integer, at least
+/// 1), for studies of mesh convergence that need not know each block's cells. A direction in which
+/// every block has one cell (the thickness of a 2D scene) stays at one cell. Gradings are kept (the
+/// last/first size ratio of each block), so the refined grid resolves the same geometry; touching
+/// blocks that shared a grid still do. Throws InputError when `factor` is not positive and finite
+/// or when a refined count exceeds what an int holds.
+void refineBlocks(BlockMeshSpec& spec, real factor);
+
 /// Convenience: a single box.
 BlockMeshSpec boxSpec(std::array<real, 3> min, std::array<real, 3> max, std::array<int, 3> cells);
 

@@ -83,6 +83,7 @@ void checkBlockMeshSize(const SceneConfig& mesh, const BlockMeshSpec& spec) {
   std::ostringstream what;
   what << "cells [" << c[0] << ", " << c[1] << ", " << c[2] << "]";
   if (spec.blocks.size() > 1) what << " (the largest of " << spec.blocks.size() << " blocks)";
+  if (const double refine = mesh.get<double>("refine"); refine != 1) what << " (after mesh.refine = " << refine << ")";
   what << " make a mesh of " << countText(total.cells) << " cells, " << countText(total.nodes) << " nodes and "
        << countText(total.faces) << " faces";
   const SourceLocation where = mesh.where("blocks." + std::to_string(largest) + ".cells");
@@ -132,7 +133,13 @@ Schema meshSchema() {
       .key("patchTypes", Schema::freeMap("kind per patch name", Schema::choice("patch kind", {"patch", "wall", "symmetry", "empty"})),
            Presence::Optional)
       .key("defaultPatch", Schema::string("patch collecting boundary faces no other patch claims"),
-           Default("defaultFaces"));
+           Default("defaultFaces"))
+      .key("refine",
+           Schema::real("factor multiplying every block's cells (rounded, at least 1; a direction with one cell "
+                        "in every block, a 2D scene's thickness, stays one cell; blocks only)",
+                        "-")
+               .greaterThan(0),
+           Default(1.0));
 }
 
 HexMesh buildMesh(const SceneConfig& mesh) {
@@ -169,6 +176,11 @@ HexMesh buildMesh(const SceneConfig& mesh) {
     }
     for (const auto& name : mesh.keys("patchTypes"))
       spec.patchKinds[name] = patchKindOf(mesh.get<std::string>("patchTypes." + name));
+    try {
+      refineBlocks(spec, mesh.get<double>("refine"));
+    } catch (const InputError& e) {
+      throw InputError(mesh.where("refine"), e.what());
+    }
     checkBlockMeshSize(mesh, spec);
     if (const auto m = findMismatchedContact(spec)) {
       // Point at the first block's key to fix, and say where the second one's is.
@@ -192,6 +204,10 @@ HexMesh buildMesh(const SceneConfig& mesh) {
   } else {
     if (mesh.size("baffles") > 0)
       throw InputError(mesh.where("baffles"), "baffles on grid planes need generated 'blocks'");
+    if (mesh.get<double>("refine") != 1)
+      throw InputError(mesh.where("refine"),
+                       "refine multiplies the cells of generated 'blocks'; a mesh file is "
+                       "refined by making a finer file");
     std::filesystem::path p = mesh.get<std::string>("file");
     if (p.is_relative()) p = std::filesystem::path(mesh.file()).parent_path() / p;
     if (!std::filesystem::exists(p)) throw InputError(mesh.where("file"), "mesh file not found: " + p.string());

@@ -3,33 +3,80 @@
 #include "core/Error.hpp"
 #include "core/Timers.hpp"
 
+#include <fcntl.h>
+#include <sys/stat.h>
 #include <unistd.h>
 
+#include <algorithm>
+#include <cerrno>
 #include <cmath>
+#include <cstring>
 #include <filesystem>
+#include <fstream>
 #include <iomanip>
 #include <sstream>
 
 namespace mfsi {
 
+namespace {
+
+/// The length of the well-formed UTF-8 sequence that starts at `s[i]` (Unicode 15, table 3-7:
+/// no overlong forms, no surrogates, nothing above U+10FFFF), 0 when none does.
+std::size_t utf8Sequence(const std::string& s, std::size_t i) {
+  const auto byte = [&](std::size_t k) { return static_cast<unsigned char>(s[k]); };
+  const unsigned char lead = byte(i);
+  if (lead < 0x80) return 1;
+  std::size_t n = 0;
+  unsigned char lo = 0x80, hi = 0xBF;  // the range of the second byte
+  if (lead >= 0xC2 && lead <= 0xDF) {
+    n = 2;
+  } else if (lead >= 0xE0 && lead <= 0xEF) {
+    n = 3;
+    if (lead == 0xE0) lo = 0xA0;
+    if (lead == 0xED) hi = 0x9F;
+  } else if (lead >= 0xF0 && lead <= 0xF4) {
+    n = 4;
+    if (lead == 0xF0) lo = 0x90;
+    if (lead == 0xF4) hi = 0x8F;
+  } else {
+    return 0;
+  }
+  if (i + n > s.size() || byte(i + 1) < lo || byte(i + 1) > hi) return 0;
+  for (std::size_t k = 2; k < n; ++k)
+    if (byte(i + k) < 0x80 || byte(i + k) > 0xBF) return 0;
+  return n;
+}
+
+}  // namespace
+
 std::string jsonEscape(const std::string& s) {
-  std::ostringstream os;
-  for (unsigned char c : s) {
+  static const char* const hex = "0123456789abcdef";
+  std::string o;
+  o.reserve(s.size());
+  for (std::size_t i = 0; i < s.size();) {
+    const unsigned char c = static_cast<unsigned char>(s[i]);
     switch (c) {
-      case '"': os << "\\\""; break;
-      case '\\': os << "\\\\"; break;
-      case '\n': os << "\\n"; break;
-      case '\r': os << "\\r"; break;
-      case '\t': os << "\\t"; break;
+      case '"': o += "\\\""; break;
+      case '\\': o += "\\\\"; break;
+      case '\n': o += "\\n"; break;
+      case '\r': o += "\\r"; break;
+      case '\t': o += "\\t"; break;
       default:
         if (c < 0x20) {
-          os << "\\u" << std::hex << std::setw(4) << std::setfill('0') << static_cast<int>(c) << std::dec;
+          o += "\\u00";
+          o += hex[c >> 4];
+          o += hex[c & 0xF];
+        } else if (const std::size_t n = utf8Sequence(s, i); n > 0) {
+          o.append(s, i, n);
+          i += n;
+          continue;
         } else {
-          os << c;
+          o += "\\ufffd";
         }
     }
+    ++i;
   }
-  return os.str();
+  return o;
 }
 
 namespace {
@@ -71,22 +118,55 @@ std::string toJson(const RunSummary& s) {
   return os.str();
 }
 
-void writeTextAtomically(const std::string& path, const std::string& text) {
-  const std::string tmp = path + ".part";
-  {
-    std::ofstream out(tmp, std::ios::binary | std::ios::trunc);
-    out << text;
-    out.flush();
-    if (!out) {
-      out.close();
-      std::error_code ec;
-      std::filesystem::remove(tmp, ec);
-      throw OutputError("cannot write '" + tmp + "' (is the disk full?)");
+namespace {
+
+/// Write all of `data` to `fd` (a short write is continued; a write the system refuses ends it).
+/// False, with errno set, when it fails. Large data goes in pieces of 1 MiB: one write() of a
+/// 130 MB checkpoint took 0.3-0.5 s against 0.02-0.07 s in pieces (Linux 6.18, ext4, a VM).
+bool writeAll(int fd, const char* data, std::size_t size) {
+  constexpr std::size_t kPiece = std::size_t(1) << 20;
+  while (size > 0) {
+    const ssize_t n = ::write(fd, data, std::min(size, kPiece));
+    if (n < 0 && errno == EINTR) continue;
+    if (n <= 0) {
+      if (n == 0) errno = EIO;
+      return false;
     }
+    data += n;
+    size -= static_cast<std::size_t>(n);
   }
+  return true;
+}
+
+std::string writeFailure(const std::string& path, int err) {
+  return "cannot write '" + path + "': " + std::strerror(err) + " (is the disk full?)";
+}
+
+}  // namespace
+
+void writeBytesAtomically(const std::string& path, const char* data, std::size_t size) {
+  const std::string tmp = path + ".part";
+  const int fd = ::open(tmp.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0644);
+  if (fd < 0)
+    throw OutputError("cannot create '" + tmp + "': " + std::strerror(errno) + " (is the folder there and writable?)");
+  const bool written = writeAll(fd, data, size);
+  int err = written ? 0 : errno;
+  if (::close(fd) != 0 && err == 0) err = errno;  // a deferred write error (NFS, quota) shows here
   std::error_code ec;
+  if (err != 0) {
+    std::filesystem::remove(tmp, ec);
+    throw OutputError(writeFailure(path, err));
+  }
   std::filesystem::rename(tmp, path, ec);
-  if (ec) throw OutputError("cannot rename '" + tmp + "' to '" + path + "': " + ec.message());
+  if (ec) {
+    std::error_code ignored;
+    std::filesystem::remove(tmp, ignored);
+    throw OutputError("cannot rename '" + tmp + "' to '" + path + "': " + ec.message());
+  }
+}
+
+void writeTextAtomically(const std::string& path, const std::string& text) {
+  writeBytesAtomically(path, text.data(), text.size());
 }
 
 void writeSummary(const std::string& dir, const RunSummary& s) {
@@ -94,13 +174,17 @@ void writeSummary(const std::string& dir, const RunSummary& s) {
   writeTextAtomically(dir + "/summary.json", toJson(s));
 }
 
-StepLog::StepLog(const std::string& path, std::vector<std::string> columns)
-    : path_(path), out_(path), nColumns_(columns.size()) {
-  if (!out_) throw OutputError("cannot write '" + path + "'");
-  for (std::size_t i = 0; i < columns.size(); ++i) out_ << (i ? "," : "") << columns[i];
-  out_ << "\n";
-  out_.flush();
-  if (!out_) throw OutputError("cannot write '" + path + "' (is the disk full?)");
+namespace {
+std::string csvHeader(const std::vector<std::string>& columns) {
+  std::string header;
+  for (std::size_t i = 0; i < columns.size(); ++i) header += (i ? "," : "") + columns[i];
+  return header;
+}
+}  // namespace
+
+StepLog::StepLog(const std::string& path, std::vector<std::string> columns) : path_(path), nColumns_(columns.size()) {
+  writeTextAtomically(path, csvHeader(columns) + "\n");  // never a cut-off header
+  openForAppend();
 }
 
 void keepCsvRows(const std::string& path, const std::string& header, long long rows) {
@@ -123,20 +207,63 @@ void keepCsvRows(const std::string& path, const std::string& header, long long r
 
 StepLog::StepLog(const std::string& path, std::vector<std::string> columns, long long keepRows)
     : path_(path), nColumns_(columns.size()) {
-  std::string header;
-  for (std::size_t i = 0; i < columns.size(); ++i) header += (i ? "," : "") + columns[i];
-  keepCsvRows(path, header, keepRows);
-  out_.open(path, std::ios::app);
-  if (!out_) throw OutputError("cannot write '" + path + "'");
+  keepCsvRows(path, csvHeader(columns), keepRows);
+  openForAppend();
+}
+
+StepLog::StepLog(StepLog&& o) noexcept
+    : path_(std::move(o.path_)), fd_(o.fd_), written_(o.written_), nColumns_(o.nColumns_) {
+  o.fd_ = -1;
+}
+
+StepLog& StepLog::operator=(StepLog&& o) noexcept {
+  if (this != &o) {
+    close();
+    path_ = std::move(o.path_);
+    fd_ = o.fd_;
+    written_ = o.written_;
+    nColumns_ = o.nColumns_;
+    o.fd_ = -1;
+  }
+  return *this;
+}
+
+StepLog::~StepLog() { close(); }
+
+void StepLog::close() noexcept {
+  if (fd_ >= 0) ::close(fd_);
+  fd_ = -1;
+}
+
+void StepLog::openForAppend() {
+  fd_ = ::open(path_.c_str(), O_WRONLY | O_APPEND | O_CLOEXEC);
+  struct stat st {};
+  if (fd_ < 0 || ::fstat(fd_, &st) != 0) {
+    const int err = errno;
+    close();
+    throw OutputError("cannot open '" + path_ + "' to append: " + std::strerror(err));
+  }
+  written_ = static_cast<long long>(st.st_size);
 }
 
 void StepLog::row(const std::vector<double>& values) {
   MFSI_ASSERT(values.size() == nColumns_, "step log row has " << values.size() << " values for " << nColumns_);
-  out_ << std::setprecision(12);
-  for (std::size_t i = 0; i < values.size(); ++i) out_ << (i ? "," : "") << values[i];
-  out_ << "\n";
-  out_.flush();
-  if (!out_) throw OutputError("cannot write '" + path_ + "' (is the disk full?)");
+  if (fd_ < 0) throw OutputError("cannot write '" + path_ + "': an earlier write failed");
+  std::ostringstream line;
+  line << std::setprecision(12);
+  for (std::size_t i = 0; i < values.size(); ++i) line << (i ? "," : "") << values[i];
+  line << "\n";
+  const std::string text = line.str();
+  if (writeAll(fd_, text.data(), text.size())) {
+    written_ += static_cast<long long>(text.size());
+    return;
+  }
+  // Keep whole rows: cut off what the failed write left of this one (shrinking a file needs no
+  // space), and take no more rows.
+  const int err = errno;
+  const bool cut = ::ftruncate(fd_, static_cast<off_t>(written_)) == 0;
+  close();
+  throw OutputError(writeFailure(path_, err) + (cut ? "" : "; its last row may be cut short"));
 }
 
 bool stdoutIsTerminal() { return ::isatty(STDOUT_FILENO) == 1; }

@@ -2,8 +2,8 @@
 /// \file
 /// \brief What every run leaves behind: `summary.json` (the stable machine-readable contract),
 /// a per-step CSV log, and a progress display.
+#include <cstddef>
 #include <cstdio>
-#include <fstream>
 #include <map>
 #include <string>
 #include <vector>
@@ -29,17 +29,27 @@ struct RunSummary {
   std::map<std::string, double> metrics;
 };
 
-/// JSON text of a summary (non-finite numbers are written as null).
+/// JSON text of a summary (non-finite numbers are written as null). Always valid UTF-8 JSON,
+/// whatever bytes the strings hold (see jsonEscape).
 std::string toJson(const RunSummary& s);
 
-/// Write `text` to `path` through a temporary file (`<path>.part`) and a rename, so the file is
-/// never half-written. Throws OutputError when the write or the rename fails.
+/// Write `size` bytes to `path` through a temporary file (`<path>.part`) and a rename, so the file
+/// is never half-written: on any failure the temporary file is removed and a file already at
+/// `path` stays as it was. Throws OutputError naming `path` and the system's reason (a failed
+/// write adds "is the disk full?").
+void writeBytesAtomically(const std::string& path, const char* data, std::size_t size);
+/// writeBytesAtomically of a text.
 void writeTextAtomically(const std::string& path, const std::string& text);
 
 /// Write `dir/summary.json` atomically (temporary file + rename); creates `dir`.
 void writeSummary(const std::string& dir, const RunSummary& s);
 
-/// Escape a string for JSON.
+/// \brief Escape a string for JSON (without the quotes), so that the result is valid UTF-8 JSON
+/// whatever the bytes: `"` and `\` are escaped, control characters (U+0000 to U+001F) are written
+/// as \n, \r, \t or \u00XX, well-formed UTF-8 is copied as it is, and each byte that is not part
+/// of a well-formed UTF-8 sequence (a Latin-1 file name, a cut-off or overlong sequence, an encoded
+/// surrogate) becomes \ufffd, the replacement character: a name with such bytes stays readable
+/// and never passes for another valid name.
 std::string jsonEscape(const std::string& s);
 
 /// \brief Per-step CSV log (`steps.csv`): a header of column names, then one row per step.
@@ -56,14 +66,24 @@ class StepLog {
   /// `keepRows` rows (the steps up to the checkpoint), drop the later ones, append from there.
   /// Throws InputError when the file is missing, has other columns or fewer rows.
   StepLog(const std::string& path, std::vector<std::string> columns, long long keepRows);
-  /// Append a row and flush it (a stopped run keeps every step it finished). Throws OutputError
-  /// when the write fails.
+  StepLog(StepLog&& other) noexcept;
+  StepLog& operator=(StepLog&& other) noexcept;
+  StepLog(const StepLog&) = delete;
+  StepLog& operator=(const StepLog&) = delete;
+  ~StepLog();
+  /// Append a row in one write (a stopped run keeps every step it finished). Throws OutputError
+  /// when the write fails; the file then keeps exactly the whole rows before it (what a failed
+  /// write left of the row is cut off) and takes no more.
   void row(const std::vector<double>& values);
-  bool isOpen() const { return out_.is_open(); }
+  bool isOpen() const { return fd_ >= 0; }
 
  private:
+  void openForAppend();
+  void close() noexcept;
+
   std::string path_;
-  std::ofstream out_;
+  int fd_ = -1;            ///< the file, opened to append
+  long long written_ = 0;  ///< its size: the header and the whole rows
   std::size_t nColumns_ = 0;
 };
 

@@ -39,7 +39,11 @@ double dot(const Vec3& a, const Vec3& b) { return a[0] * b[0] + a[1] * b[1] + a[
 }  // namespace
 
 FluidModule::FluidModule(const HexMesh& mesh, const FluidOptions& options, FluidReports reports)
-    : Module("fluid"), solver_(mesh, options), reports_(std::move(reports)) {
+    : Module("fluid"),
+      solver_(mesh, options),
+      reports_(std::move(reports)),
+      runaway_(solver_, options.divergenceVelocityFactor) {
+  if (options.means.enabled) means_.emplace(mesh.nCells(), options.means);
   if (reports_.probes.empty()) return;
   // Nearest cell centroids, found once on the mesh as built.
   const std::size_t n = reports_.probes.size();
@@ -67,11 +71,21 @@ std::vector<double> FluidModule::probeValues() const {
 }
 
 void FluidModule::advance(const TimeState& t) {
+  step_ = t;
   last_ = solver_.solveStep(t.time, t.dt);
   account(t);
+  endStep();
 }
 
-void FluidModule::beginStep(const TimeState& t) { solver_.beginStep(t.time, t.dt); }
+void FluidModule::beginStep(const TimeState& t) {
+  step_ = t;
+  solver_.beginStep(t.time, t.dt);
+}
+
+void FluidModule::endStep() {
+  runaway_.check(solver_, step_.time, step_.dt);
+  if (means_) means_->accumulate(ExecSpace(), step_.time + step_.dt, step_.dt, solver_.velocity(), solver_.pressure());
+}
 
 void FluidModule::solveIteration(const TimeState& t) {
   last_ = solver_.solve();
@@ -132,6 +146,10 @@ void FluidModule::addOutputFields(io::FieldFrame& frame) {
   const std::size_t n = static_cast<std::size_t>(solver_.mesh().nCells());
   grid->addCellField("U", 3, io::hostValues(solver_.velocity(), n));
   grid->addCellField("p", 1, io::hostValues(solver_.pressure(), n));
+  if (means_) {
+    grid->addCellField("UMean", 3, io::hostValues(means_->velocity(), n));
+    grid->addCellField("pMean", 1, io::hostValues(means_->pressure(), n));
+  }
 }
 
 void FluidModule::addMetrics(std::map<std::string, double>& m) const {
@@ -143,13 +161,9 @@ void FluidModule::addMetrics(std::map<std::string, double>& m) const {
   m["fluid.final_momentum_residual"] = last_.finalMomentumResidual;
   m["fluid.final_pressure_residual"] = last_.finalPressureResidual;
   m["fluid.converged"] = last_.converged ? 1.0 : 0.0;
-  {
-    auto U = Kokkos::create_mirror_view_and_copy(HostSpace(), solver_.velocity());
-    double umax = 0;
-    for (int c = 0; c < static_cast<int>(U.extent(0)); ++c)
-      umax = std::max(umax, std::sqrt(U(c, 0) * U(c, 0) + U(c, 1) * U(c, 1) + U(c, 2) * U(c, 2)));
-    m["fluid.max_velocity"] = umax;
-  }
+  m["fluid.max_velocity"] = maxVelocity(solver_);
+  if (runaway_.enabled()) m["fluid.velocity_scale"] = runaway_.scale();
+  if (means_) m["fluid.means_time"] = means_->averagedTime();
   const double rho = solver_.options().density;
   for (const auto& f : reports_.forces) {
     const PatchLoads L = patchLoads(solver_, f.patch, f.point);
@@ -202,6 +216,11 @@ void FluidModule::saveState(io::StateWriter& w) const {
                                         l.pressureResidual, l.finalMomentumResidual, l.finalPressureResidual,
                                         l.continuityMax, l.continuitySum});
   w.put("totals", std::vector<std::int64_t>{outerTotal_, pressureTotal_, momentumTotal_});
+  runaway_.saveState(w);
+  if (means_) {
+    io::StateWriter mw = w.sub("means");
+    means_->saveState(mw);
+  }
 }
 
 void FluidModule::loadState(const io::StateReader& r) {
@@ -223,6 +242,8 @@ void FluidModule::loadState(const io::StateReader& r) {
   outerTotal_ = t[0];
   pressureTotal_ = t[1];
   momentumTotal_ = t[2];
+  runaway_.loadState(r);
+  if (means_) means_->loadState(r.sub("means"));
 }
 
 }  // namespace mfsi

@@ -5,6 +5,10 @@
 #include "coupling/Module.hpp"
 #include "fluid/FluidConfig.hpp"
 #include "fluid/FluidSolver.hpp"
+#include "fluid/RunawayGuard.hpp"
+#include "fluid/RunningMean.hpp"
+
+#include <optional>
 
 namespace mfsi {
 
@@ -13,21 +17,24 @@ class FluidModule final : public Module {
   /// Solver on `mesh` (which must outlive the module) with `options`; `reports` name what
   /// addMetrics computes.
   FluidModule(const HexMesh& mesh, const fluid::FluidOptions& options, FluidReports reports);
-  /// One time step (steady: `pimple.outerCorrectors` SIMPLE iterations). Throws DivergenceError
-  /// when the solver reports a breakdown or non-finite fields.
+  /// One time step (steady: `pimple.outerCorrectors` SIMPLE iterations), then endStep. Throws
+  /// DivergenceError when the solver reports a breakdown or non-finite fields, or on runaway growth.
   void advance(const TimeState& t) override;
   void saveState(io::StateWriter& w) const override;
   void loadState(const io::StateReader& r) override;
   /// The steps of advance, for a module that iterates the fluid within a step (the coupling):
   /// beginStep, then solveIteration once per coupling iteration (PIMPLE on the current mesh and
-  /// wall velocities, from the current iterate). solveIteration throws DivergenceError like advance.
+  /// wall velocities, from the current iterate), then endStep once the step's iterate is final.
+  /// solveIteration throws DivergenceError like advance.
   void beginStep(const TimeState& t);
   void solveIteration(const TimeState& t);
-  void endStep() {}
-  /// fluid.* numbers: continuity, iteration totals, last residuals, forces, pressure differences,
-  /// Ghia errors.
+  /// The end of the step begun last: the runaway-growth check (fluid.divergenceVelocityFactor;
+  /// throws DivergenceError) and the running means (fluid.means).
+  void endStep();
+  /// fluid.* numbers: continuity, iteration totals, last residuals, max |U| and the velocity scale
+  /// of the runaway check, forces, pressure differences, Ghia errors.
   void addMetrics(std::map<std::string, double>& metrics) const override;
-  /// U and p as cell fields of the scene mesh's grid.
+  /// U and p as cell fields of the scene mesh's grid (and UMean, pMean with fluid.means).
   void addOutputFields(io::FieldFrame& frame) override;
   /// Per step: iteration counts and residuals; each probe's p, Ux, Uy, Uz; each force report's
   /// force and moment (and c_D, c_L with a reference velocity); each pressure difference.
@@ -36,6 +43,9 @@ class FluidModule final : public Module {
 
   fluid::FluidSolver& solver() { return solver_; }
   const fluid::StepResult& lastStep() const { return last_; }
+  const fluid::RunawayGuard& runawayGuard() const { return runaway_; }
+  /// The running means (null without fluid.means).
+  const fluid::RunningMean* means() const { return means_ ? &*means_ : nullptr; }
 
   /// The probes' cell values now: p, Ux, Uy, Uz per probe (public for nvcc: it launches a kernel).
   std::vector<double> probeValues() const;
@@ -48,6 +58,9 @@ class FluidModule final : public Module {
   IndexView probeCells_;  ///< the cells of reports_.probes
   RealView probeValues_;
   fluid::StepResult last_;
+  TimeState step_;  ///< the step begun last
+  fluid::RunawayGuard runaway_;
+  std::optional<fluid::RunningMean> means_;
   long long outerTotal_ = 0, pressureTotal_ = 0, momentumTotal_ = 0;
 };
 

@@ -219,6 +219,24 @@ Schema fluidSchema() {
            Schema::real("artificial compressibility: (1/(rho c^2)) dp/dt + div u = 0; 0 = incompressible", "m/s")
                .atLeast(0),
            Default(d.artificialCompressibility.soundSpeed))
+      .key("divergenceVelocityFactor",
+           Schema::real("runaway-growth guard: the run stops as diverged when max |U| over the cells exceeds this "
+                        "factor times the velocity scale of the scene, checked once per step (0: off). The scale is "
+                        "the largest of: the prescribed boundary velocities at the peak of their time functions "
+                        "(fixedVelocity, wall velocities, flowRate / patch area times the profile's peak-to-mean "
+                        "ratio), |initial.velocity|, sqrt(2 dp / rho) for the range dp of the prescribed and initial "
+                        "pressures, sqrt(2 |g| L) for the body force and the mesh's bounding-box diagonal L, and the "
+                        "largest velocity of a moving wall, membrane or mesh boundary seen so far in the run",
+                        "-")
+               .atLeast(0),
+           Default(d.divergenceVelocityFactor))
+      .key("means",
+           Schema::map("running time means of U and p, cell fields UMean and pMean of the field output, weighted by "
+                       "the time step as OpenFOAM's fieldAverage: mean = (1 - dt/T) mean + (dt/T) field, T the time "
+                       "averaged so far (zero until the first step that enters)")
+               .key("start", Schema::real("steps that end at or after this time enter the means", "s"),
+                    Default(d.means.start)),
+           Presence::OptionalSection)
       .key("timeScheme",
            Schema::choice("steady: SIMPLE; euler: implicit Euler; bdf2: second-order backward differences",
                           {"steady", "euler", "bdf2"}),
@@ -313,6 +331,9 @@ FluidOptions readFluidOptions(const SceneConfig& c, const HexMesh& mesh) {
                                  ? PressurePreconditioner::Jacobi
                                  : PressurePreconditioner::Amg;
   o.pressurePreconditionerRefresh = c.get<int>("solvers.pressure.preconditionerRefresh");
+  o.divergenceVelocityFactor = c.get<double>("divergenceVelocityFactor");
+  o.means.enabled = c.has("means");
+  if (o.means.enabled) o.means.start = c.get<double>("means.start");
   o.initialVelocity = vec3(c, "initial.velocity");
   o.initialPressure = c.get<double>("initial.pressure");
 

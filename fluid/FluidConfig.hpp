@@ -23,6 +23,8 @@
 ///   pressureDifferences:
 ///     - {name: dp, from: [0.15, 0.2, 0], to: [0.25, 0.2, 0], patch: cylinder}
 ///   ghia: {re: 100, lidSpeed: 1}
+///   divergenceVelocityFactor: 100  # stop as diverged when max |U| > 100 x the scene's velocity scale
+///   means: {start: 5}              # UMean, pMean from t = 5 on, in the field output
 /// \endcode
 #include "core/HexMesh.hpp"
 #include "core/SceneConfig.hpp"

@@ -166,6 +166,13 @@ struct ArtificialCompressibilityOptions {
   real soundSpeed = 0.0;  ///< c [m/s]; 0 switches the term off (incompressible). Ignored when steady.
 };
 
+/// \brief Time means of U and p accumulated by a run, weighted by the time step (OpenFOAM's
+/// fieldAverage mean). Read by the module that runs the solver, not by the solver.
+struct RunningMeanOptions {
+  bool enabled = false;
+  real start = 0.0;  ///< steps that end at or after this time [s] enter the means
+};
+
 /// \brief All options of `FluidSolver`.
 struct FluidOptions {
   real density = 1.0;       ///< rho [kg/m^3]
@@ -211,6 +218,12 @@ struct FluidOptions {
   Vec3 initialVelocity{0, 0, 0};
   real initialPressure = 0;
   ArtificialCompressibilityOptions artificialCompressibility;
+  /// Runaway-growth guard of a run (fluid/RunawayGuard.hpp): once per time step, the run stops as
+  /// diverged when max |U| over the cells exceeds this factor times the velocity scale of the
+  /// scene's boundary conditions. 0 switches it off. The solver itself does not read it.
+  real divergenceVelocityFactor = 100.0;
+  /// Running time means UMean, pMean (fluid/RunningMean.hpp).
+  RunningMeanOptions means;
   /// Boundary condition per patch name (patches of kind wall/symmetry/empty/baffle may be omitted).
   std::map<std::string, PatchBC> boundaries;
 };

@@ -129,6 +129,8 @@ class FluidSolver {
   ConstReal3View boundaryVelocity() const { return Ub_; }
   /// Pressure on boundary faces (index f - nInternalFaces).
   ConstRealView boundaryPressure() const { return pb_; }
+  /// Mesh velocity of the current step on boundary faces (index f - nInternalFaces) [m/s].
+  ConstReal3View boundaryMeshVelocity() const { return faceMeshVel_; }
   /// Velocity gradient G(c, i, j) = du_j/dx_i: the one the last outer iteration used, or, where the
   /// discretisation did not need it (orthogonal mesh, linear/upwind convection), computed from the
   /// current velocity on first request.

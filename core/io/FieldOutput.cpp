@@ -196,16 +196,25 @@ void FieldSeries::write(const FieldFrame& frame) {
     entry.grids.push_back(std::move(ge));
   }
   h5.commit();
-  for (auto& [name, next] : pending) {  // only once the frame is on disk
+  // The frame counts once the index lists it (a checkpoint lists the frames the index does): when
+  // the index cannot be written, its previous version stays, without this frame (whose complete
+  // file stays unlisted).
+  entries_.push_back(std::move(entry));
+  try {
+    writeTextAtomically(indexPath_, xdmf());
+  } catch (const OutputError&) {
+    entries_.pop_back();
+    throw;
+  }
+  const std::string& file = entries_.back().file;
+  for (auto& [name, next] : pending) {
     Written& w = written_[name];
-    if (next.pointsFile == entry.file) w.points = std::move(next.points);
-    if (next.topologyFile == entry.file) w.topology = std::move(next.topology);
+    if (next.pointsFile == file) w.points = std::move(next.points);
+    if (next.topologyFile == file) w.topology = std::move(next.topology);
     w.pointsFile = next.pointsFile;
     w.topologyFile = next.topologyFile;
     w.geometricFiles = std::move(next.geometricFiles);
   }
-  entries_.push_back(std::move(entry));
-  writeTextAtomically(indexPath_, xdmf());
 }
 
 // One record per line, fields separated by tabs (names never hold tabs or line breaks):

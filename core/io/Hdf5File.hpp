@@ -5,8 +5,11 @@
 ///
 /// A file being written lives under a temporary name (`<path>.part`) and appears at its own path
 /// only on `commit()`, so a crash, a signal or a full disk never leaves a truncated file that looks
-/// complete. Serial HDF5 calls on the library of Debian's Open MPI build; a distributed run will add
-/// per-rank hyperslabs of the same datasets.
+/// complete. It is built in memory (as much memory as the file) and written into the temporary
+/// file by `commit()`, so that a failed write (a full disk) fails in a checked write of ours rather
+/// than inside HDF5, which cannot recover from one. Serial HDF5 calls on the library of Debian's
+/// Open MPI build; a distributed run will add per-rank hyperslabs of the same datasets (through
+/// MPI-IO, which will need its own answer to a full disk).
 #include <cstdint>
 #include <string>
 #include <vector>
@@ -45,7 +48,9 @@ class Hdf5File {
   /// The shape of a dataset. Throws OutputError when absent.
   std::vector<std::size_t> shape(const std::string& dataset) const;
 
-  /// Flush and close the file, then rename it to its path. Throws OutputError when any of it fails.
+  /// Write the file to `<path>.part` and rename it to its path. Throws OutputError naming the path
+  /// when any of it fails (nothing is then left at `<path>.part`, and a file already at `path`
+  /// stays as it was).
   void commit();
 
   const std::string& path() const { return path_; }

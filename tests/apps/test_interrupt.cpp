@@ -4,14 +4,10 @@
 // uninterrupted run's (but the wall time).
 #include "support/CubeCavity.hpp"
 #include "support/FreshDir.hpp"
+#include "support/Spawn.hpp"
 #include "support/TextFiles.hpp"
 
 #include <gtest/gtest.h>
-
-#include <fcntl.h>
-#include <spawn.h>
-#include <sys/wait.h>
-#include <unistd.h>
 
 #include <chrono>
 #include <csignal>
@@ -22,32 +18,15 @@
 #include <thread>
 #include <vector>
 
-extern char** environ;
-
 namespace {
+
+using mfsi::test::finish;
 
 const std::string kScene = mfsi::test::cubeCavityScene(14, 8);
 
-pid_t start(const std::vector<std::string>& args, const std::string& log) {
-  std::vector<std::string> all = {MFSI_EXE};
-  all.insert(all.end(), args.begin(), args.end());
-  std::vector<char*> argv;
-  for (auto& a : all) argv.push_back(a.data());
-  argv.push_back(nullptr);
-  posix_spawn_file_actions_t actions;
-  posix_spawn_file_actions_init(&actions);
-  posix_spawn_file_actions_addopen(&actions, 1, log.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
-  posix_spawn_file_actions_adddup2(&actions, 1, 2);
-  pid_t pid = -1;
-  const int rc = posix_spawn(&pid, MFSI_EXE, &actions, nullptr, argv.data(), environ);
-  posix_spawn_file_actions_destroy(&actions);
-  return rc == 0 ? pid : -1;
-}
-
-int finish(pid_t pid) {
-  int status = 0;
-  waitpid(pid, &status, 0);
-  return WIFEXITED(status) ? WEXITSTATUS(status) : 1000 + WTERMSIG(status);
+pid_t start(std::vector<std::string> args, const std::string& log) {
+  args.insert(args.begin(), MFSI_EXE);
+  return mfsi::test::start(args, log);
 }
 
 /// The file's text, "" while it does not exist (polled while the run starts).

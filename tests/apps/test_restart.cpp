@@ -130,6 +130,12 @@ TEST(Restart, TheTransientCubeCavityContinuesBitwise) {
   expectRestartIsBitwise("cavity3d", kCavity3d, {}, 10);
 }
 
+// Running means that started before the checkpoint (t = 0.1, step 5 of 20) continue from it: the
+// means, the time they average and the runaway guard's running maximum are part of the state.
+TEST(Restart, TheCubeCavityWithRunningMeansContinuesBitwise) {
+  expectRestartIsBitwise("cavity3d_means", kCavity3d, {"fluid.means.start=0.1"}, 10);
+}
+
 TEST(Restart, AChangedSceneIsRefusedWithWhatChanged) {
   const std::string dir = mfsi::test::freshDir("restart_changed");
   {

@@ -293,3 +293,67 @@ TEST(MeshConfig, MeshesTooLargeToIndexOrToHoldAreRefusedBeforeAllocating) {
   EXPECT_HAS(big, "TB (mesh and solver fields, ~5 kB per cell), more than the ");
   EXPECT_HAS(big, "of memory of this machine");
 }
+
+// mesh.refine: every block's cells times a factor, so a study varies one key for any scene.
+TEST(BlockMesh, RefineMultipliesCellsAndKeepsTheThicknessOfA2DScene) {
+  // A 2D scene: one cell in z in every block.
+  auto s = twoBlocks(block({0, 0, 0}, {1, 1, 0.1}, {4, 3, 1}), block({1, 0, 0}, {3, 1, 0.1}, {6, 3, 1}));
+  s.blocks[0].grading = {2, 1, 1};
+  auto fine = s;
+  mfsi::refineBlocks(fine, 2);
+  EXPECT_EQ(fine.blocks[0].cells, (std::array<int, 3>{8, 6, 1}));
+  EXPECT_EQ(fine.blocks[1].cells, (std::array<int, 3>{12, 6, 1}));
+  EXPECT_EQ(fine.blocks[0].grading, s.blocks[0].grading);
+  // Still glued along x = 1: the refined interface grids match.
+  EXPECT_FALSE(mfsi::findMismatchedContact(fine).has_value());
+  EXPECT_EQ(mfsi::buildHexMesh(mfsi::generateBlockMesh(fine)).nCells(), 8 * 6 + 12 * 6);
+
+  // Rounded to the nearest count (half away from zero), never below one cell.
+  auto odd = s;
+  mfsi::refineBlocks(odd, 1.5);
+  EXPECT_EQ(odd.blocks[0].cells, (std::array<int, 3>{6, 5, 1}));  // 4.5 -> 5
+  EXPECT_EQ(odd.blocks[1].cells, (std::array<int, 3>{9, 5, 1}));
+  auto coarse = s;
+  mfsi::refineBlocks(coarse, 0.1);
+  EXPECT_EQ(coarse.blocks[0].cells, (std::array<int, 3>{1, 1, 1}));
+  EXPECT_EQ(coarse.blocks[1].cells, (std::array<int, 3>{1, 1, 1}));
+
+  // A direction with one cell in one block only is refined like the others (a thin 3D layer).
+  auto layer = twoBlocks(block({0, 0, 0}, {1, 0.1, 1}, {4, 1, 4}), block({0, 0.1, 0}, {1, 1, 1}, {4, 5, 4}));
+  mfsi::refineBlocks(layer, 2);
+  EXPECT_EQ(layer.blocks[0].cells, (std::array<int, 3>{8, 2, 8}));
+  EXPECT_EQ(layer.blocks[1].cells, (std::array<int, 3>{8, 10, 8}));
+}
+
+TEST(BlockMesh, RefineRefusesFactorsThatAreNotPositiveOrOverflow) {
+  for (const double f : {0.0, -1.0, std::nan("")}) {
+    auto s = mfsi::boxSpec({0, 0, 0}, {1, 1, 1}, {2, 2, 2});
+    EXPECT_THROW(mfsi::refineBlocks(s, f), mfsi::InputError) << f;
+  }
+  auto s = mfsi::boxSpec({0, 0, 0}, {1, 1, 1}, {2, 2, 2});
+  try {
+    mfsi::refineBlocks(s, 2e9);
+    ADD_FAILURE() << "expected an InputError";
+  } catch (const mfsi::InputError& e) {
+    EXPECT_HAS(std::string(e.what()), "more than 2147483647");
+  }
+}
+
+TEST(MeshConfig, RefineKeyScalesTheBlocksAndIsRefusedWhereItCannotApply) {
+  const auto schema = mfsi::Schema::map("scene").key("mesh", mfsi::meshSchema());
+  const auto plain = mfsi::SceneConfig::fromString(kTwoBlocks, "scene.yaml", schema);
+  EXPECT_EQ(plain.get<double>("mesh.refine"), 1.0);
+  EXPECT_EQ(mfsi::buildMesh(plain.child("mesh")).nCells(), 2000 + 3000);
+  const auto half = mfsi::SceneConfig::fromString(kTwoBlocks, "scene.yaml", schema, {"mesh.refine=0.5"});
+  EXPECT_EQ(mfsi::buildMesh(half.child("mesh")).nCells(), 10 * 5 * 5 + 15 * 5 * 5);
+
+  EXPECT_HAS(meshError(kTwoBlocks, {"mesh.refine=0"}), "mesh.refine");
+  // The size check says the cells it refuses come from the factor.
+  EXPECT_HAS(meshError(kTwoBlocks, {"mesh.refine=5000"}),
+             "key 'mesh.blocks.1.cells': cells [150000, 50000, 50000] (the largest of 2 blocks) (after mesh.refine = "
+             "5000) make a mesh of");
+  // A mesh file is not generated here: refining it is refused, naming the key.
+  const std::string fromFile = meshError("mesh:\n  file: " MFSI_TEST_DATA_DIR "/meshes/box.msh\n  refine: 2\n");
+  EXPECT_HAS(fromFile, "key 'mesh.refine'");
+  EXPECT_HAS(fromFile, "refine multiplies the cells of generated 'blocks'");
+}
