@@ -1,6 +1,8 @@
 """Check a run's fields.xdmf the way a user's reader sees it (used by tests/cli/fields_readers.cmake).
 
-    python3 check_fields.py RUN_DIR EXPECTED_FRAMES
+    python3 check_fields.py RUN_DIR EXPECTED_FRAMES [MEMBRANES]
+
+MEMBRANES: how many membrane grids the run has (default 1; 0 for a fluid-only scene).
 
 Always: the XDMF parses; every DataItem names an HDF5 dataset (h5py) whose size matches its
 Dimensions; every grid's series has EXPECTED_FRAMES times, increasing; the values are finite.
@@ -21,6 +23,7 @@ except ImportError:
     sys.exit(77)
 
 run, expected = sys.argv[1], int(sys.argv[2])
+n_membranes = int(sys.argv[3]) if len(sys.argv) > 3 else 1
 failures = []
 
 
@@ -32,7 +35,7 @@ def check(ok, what):
 root = ET.parse(os.path.join(run, "fields.xdmf")).getroot()
 series = root.find("Domain").findall("Grid")
 names = [g.get("Name") for g in series]
-check("mesh" in names and any(n.startswith("membrane") for n in names), f"grids {names}")
+check("mesh" in names and sum(n.startswith("membrane") for n in names) == n_membranes, f"grids {names}")
 times = {}
 last = {}
 for s in series:
@@ -81,7 +84,8 @@ else:
     walk(servermanager.Fetch(reader))
     meshes = [b for b in blocks if b.GetCellData().GetArray("p") is not None]
     surfaces = [b for b in blocks if b.GetCellData().GetArray("vonMises") is not None]
-    check(len(meshes) == 1 and len(surfaces) == 1, f"ParaView found {len(meshes)} meshes, {len(surfaces)} membranes")
+    check(len(meshes) == 1 and len(surfaces) == n_membranes,
+          f"ParaView found {len(meshes)} meshes, {len(surfaces)} membranes")
     if meshes:
         m = meshes[0]
         check(m.GetNumberOfCells() == p.size and m.GetCellType(0) == 12, "ParaView's mesh: cells or type")
