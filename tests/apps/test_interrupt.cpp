@@ -4,6 +4,7 @@
 // uninterrupted run's (but the wall time).
 #include "support/CubeCavity.hpp"
 #include "support/FreshDir.hpp"
+#include "support/StepsCsv.hpp"
 #include "support/Spawn.hpp"
 #include "support/TextFiles.hpp"
 
@@ -42,19 +43,6 @@ long rows(const std::string& csv) {
   return n - 1;
 }
 
-std::string withoutWall(const std::string& csv) {
-  std::stringstream in(read(csv));
-  std::string line, out;
-  while (std::getline(in, line)) {
-    std::stringstream ls(line);
-    int i = 0;
-    for (std::string c; std::getline(ls, c, ','); ++i)
-      if (i != 2) out += c + ",";
-    out += "\n";
-  }
-  return out;
-}
-
 void interruptAndContinue(int signal, const std::string& tag) {
   const std::string dir = mfsi::test::freshDir("interrupt_" + tag);
   const std::string scene = dir + "/scene_in.yaml";
@@ -83,7 +71,8 @@ void interruptAndContinue(int signal, const std::string& tag) {
   ASSERT_EQ(finish(start({"run", "--restart", run}, dir + "/restart.log")), 0) << read(dir + "/restart.log");
   EXPECT_NE(read(run + "/summary.json").find("\"status\": \"ok\""), std::string::npos);
   EXPECT_EQ(rows(run + "/steps.csv"), 400);
-  EXPECT_EQ(withoutWall(run + "/steps.csv"), withoutWall(whole + "/steps.csv"));
+  EXPECT_EQ(mfsi::test::stepsWithoutWallTime(run + "/steps.csv"),
+            mfsi::test::stepsWithoutWallTime(whole + "/steps.csv"));
 }
 
 }  // namespace

@@ -8,6 +8,7 @@
 
 #include "support/CubeCavity.hpp"
 #include "support/FreshDir.hpp"
+#include "support/StepsCsv.hpp"
 
 #include <gtest/gtest.h>
 
@@ -41,21 +42,6 @@ bool isTiming(const std::string& name) {
     return name.size() >= e.size() && name.compare(name.size() - e.size(), e.size(), e) == 0;
   };
   return ends("/seconds") || ends("_s") || name.find(".share_") != std::string::npos;
-}
-
-/// steps.csv without its wall-time column.
-std::string stepsWithoutWall(const std::string& file) {
-  std::ifstream in(file);
-  std::string line, out;
-  while (std::getline(in, line)) {
-    std::vector<std::string> cells;
-    std::stringstream ls(line);
-    for (std::string c; std::getline(ls, c, ',');) cells.push_back(c);
-    for (std::size_t i = 0; i < cells.size(); ++i)
-      if (i != 2) out += cells[i] + ",";
-    out += "\n";
-  }
-  return out;
 }
 
 /// Every dataset of two checkpoints holds the same bits (the wall time, /run/time[4], aside).
@@ -115,7 +101,8 @@ void expectRestartIsBitwise(const std::string& tag, const std::string& source, c
   char last[64];
   std::snprintf(last, sizeof last, "/checkpoints/checkpoint_%09d.h5", 2 * n);
   expectSameCheckpoints(whole + last, split + last);
-  EXPECT_EQ(stepsWithoutWall(whole + "/steps.csv"), stepsWithoutWall(split + "/steps.csv"));
+  EXPECT_EQ(mfsi::test::stepsWithoutWallTime(whole + "/steps.csv"),
+            mfsi::test::stepsWithoutWallTime(split + "/steps.csv"));
   for (const auto& [key, value] : a.metrics) {
     ASSERT_TRUE(b.metrics.count(key)) << key;
     if (isTiming(key)) continue;

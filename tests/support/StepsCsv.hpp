@@ -1,5 +1,6 @@
 #pragma once
-// A run's steps.csv read back as columns (header names -> values per step).
+// A run's steps.csv read back as columns (header names -> values per step), or as text without its
+// wall-time column (what two runs that took different times must agree on, exactly).
 #include <fstream>
 #include <map>
 #include <sstream>
@@ -20,6 +21,20 @@ inline std::map<std::string, std::vector<double>> readSteps(const std::string& f
     for (std::size_t k = 0; k < names.size() && std::getline(s, cell, ','); ++k) cols[names[k]].push_back(std::stod(cell));
   }
   return cols;
+}
+
+/// The file's text without its third column (wall_s), row by row, each cell followed by a comma.
+inline std::string stepsWithoutWallTime(const std::string& file) {
+  std::ifstream in(file);
+  std::string line, out;
+  while (std::getline(in, line)) {
+    std::istringstream ls(line);
+    int i = 0;
+    for (std::string c; std::getline(ls, c, ','); ++i)
+      if (i != 2) out += c + ",";
+    out += "\n";
+  }
+  return out;
 }
 
 }  // namespace mfsi::test
