@@ -152,6 +152,10 @@ void FluidModule::addOutputFields(io::FieldFrame& frame) {
   }
 }
 
+bool FluidModule::steadyStateReached() const {
+  return solver_.options().timeScheme == fluid::TimeScheme::Steady && last_.converged;
+}
+
 void FluidModule::addMetrics(std::map<std::string, double>& m) const {
   m["fluid.continuity_max"] = last_.continuityMax;
   m["fluid.continuity_sum"] = last_.continuitySum;

@@ -34,6 +34,8 @@ class FluidModule final : public Module {
   /// fluid.* numbers: continuity, iteration totals, last residuals, max |U| and the velocity scale
   /// of the runaway check, forces, pressure differences, Ghia errors.
   void addMetrics(std::map<std::string, double>& metrics) const override;
+  /// Steady (timeScheme steady) and the last step's outer loop converged (outerTolerance).
+  bool steadyStateReached() const override;
   /// U and p as cell fields of the scene mesh's grid (and UMean, pMean with fluid.means).
   void addOutputFields(io::FieldFrame& frame) override;
   /// Per step: iteration counts and residuals; each probe's p, Ux, Uy, Uz; each force report's

@@ -52,6 +52,9 @@ class Module {
   const std::string& name() const { return name_; }
   /// Advance over [t.time, t.time + t.dt]. Throws DivergenceError when the solution is lost.
   virtual void advance(const TimeState& t) = 0;
+  /// True when this module solves a steady problem and its last step found it converged (its
+  /// residuals below its tolerance): a run whose modules all say so has nothing left to do.
+  virtual bool steadyStateReached() const { return false; }
   /// Named summary numbers for summary.json ("<module>.<what>").
   virtual void addMetrics(std::map<std::string, double>& /*metrics*/) const {}
   /// Open the module's own output files in the run's output folder (before the first step).

@@ -4,6 +4,7 @@
 #include "core/MeshConfig.hpp"
 #include "core/io/HostCopy.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <cstring>
@@ -26,7 +27,12 @@ Schema sceneSchema() {
       .key("time", Schema::map("time stepping")
                        .key("endTime", Schema::real("simulated end time (0: no stepping)", "s").atLeast(0), Default(0.0))
                        .key("dt", Schema::real("time step", "s").atLeast(0), Default(0.0))
-                       .key("maxSteps", Schema::integer("stop after this many steps (0: no limit)").atLeast(0), Default(0)),
+                       .key("maxSteps", Schema::integer("stop after this many steps (0: no limit)").atLeast(0), Default(0))
+                       .key("stopAtSteadyState",
+                            Schema::boolean("end the run after the step in which every module has reached its "
+                                            "steady state (a steady fluid whose residuals fell below "
+                                            "fluid.pimple.outerTolerance)"),
+                            Default(true)),
            Presence::Optional)
       .key("output",
            Schema::map("results written during the run (summary.json and steps.csv are always written)")
@@ -67,6 +73,7 @@ Simulation::Simulation(const SceneConfig& scene) {
   time_.endTime = scene.get<double>("time.endTime");
   time_.dt = scene.get<double>("time.dt");
   time_.maxSteps = scene.get<int>("time.maxSteps");
+  time_.stopAtSteadyState = scene.get<bool>("time.stopAtSteadyState");
   fieldOutput_.interval = scene.get<double>("output.fields.interval");
   fieldOutput_.everySteps = scene.get<int>("output.fields.everySteps");
   fieldOutput_.initial = scene.get<bool>("output.fields.initial");
@@ -223,6 +230,11 @@ RunResult Simulation::run(const std::string& outDir, bool terminal, bool continu
     const bool byStep = checkpoint_.everySteps > 0 && ts.step % checkpoint_.everySteps == 0;
     const bool byWall = checkpoint_.wallSeconds > 0 && wallSeconds() - lastCheckpointWall >= checkpoint_.wallSeconds;
     if (byStep || byWall) checkpoint();
+    if (time_.stopAtSteadyState && ts.step < nSteps && std::all_of(modules_.begin(), modules_.end(),
+                                        [](const auto& m) { return m->steadyStateReached(); })) {
+      r.steadyStateReached = true;
+      break;
+    }
   }
   if ((r.interruptedBy != 0 || checkpoint_.final) && lastCheckpointStep != ts.step) checkpoint();
   if (fieldOutput_.final && lastFrameStep != ts.step && r.interruptedBy == 0) writeFrame();
@@ -232,6 +244,7 @@ RunResult Simulation::run(const std::string& outDir, bool terminal, bool continu
   {
     ScopedTimer t(timers_, "metrics");
     meshMetrics(r.metrics);
+    if (r.steadyStateReached) r.metrics["time.steady_state_reached"] = 1.0;
     r.metrics["output.field_frames"] = fields.frames();
     for (const Module* m : reporting_) m->addMetrics(r.metrics);
   }
@@ -266,7 +279,7 @@ std::map<long long, fs::path> checkpointFiles(const fs::path& dir) {
 
 /// Scene keys a restart may change: when it ends and what it writes, not what it computes.
 bool restartMayChange(const std::string& difference) {
-  for (const char* key : {"time.endTime:", "time.maxSteps:", "name:", "description:"})
+  for (const char* key : {"time.endTime:", "time.maxSteps:", "time.stopAtSteadyState:", "name:", "description:"})
     if (difference.rfind(key, 0) == 0) return true;
   return difference.rfind("output.", 0) == 0;
 }

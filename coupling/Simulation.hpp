@@ -14,6 +14,7 @@ struct TimeOptions {
   real endTime = 0.0;  ///< 0: no time stepping (a mesh-only scene)
   real dt = 0.0;
   int maxSteps = 0;  ///< 0: as many as endTime/dt needs
+  bool stopAtSteadyState = true;  ///< end when every module reached its steady state
 };
 
 /// \brief When fields are written (`output.fields`).
@@ -40,6 +41,9 @@ struct RunResult {
   /// SIGINT or SIGTERM stopped the run after `steps` (a checkpoint of that state was written).
   int interruptedBy = 0;
   std::string lastCheckpoint;  ///< path of the last checkpoint written ("" if none)
+  /// Every module reached its steady state (Module::steadyStateReached) after `steps`: the run
+  /// stopped there, before time.endTime.
+  bool steadyStateReached = false;
 };
 
 class Simulation {

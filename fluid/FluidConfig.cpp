@@ -181,6 +181,10 @@ Schema fluidSchema() {
                    .greaterThan(0)
                    .atMost(1),
                Default(d.pimple.relaxPressure))
+          .key("consistent",
+               Schema::boolean("SIMPLEC (steady only): the pressure equation with rAtU = V / (a_P - H1); pressure "
+                               "then needs no under-relaxation (relaxPressure: 1), relaxVelocity < 1"),
+               Default(d.pimple.consistent))
           .key("ddtCorrection", Schema::boolean("Rhie-Chow correction of the time-derivative term"),
                Default(d.pimple.ddtCorrection))
           .key("extrapolateGuess",
@@ -316,6 +320,13 @@ FluidOptions readFluidOptions(const SceneConfig& c, const HexMesh& mesh) {
   o.pimple.outerTolerance = c.get<double>("pimple.outerTolerance");
   o.pimple.relaxVelocity = c.get<double>("pimple.relaxVelocity");
   o.pimple.relaxPressure = c.get<double>("pimple.relaxPressure");
+  o.pimple.consistent = c.get<bool>("pimple.consistent");
+  if (o.pimple.consistent && o.timeScheme != TimeScheme::Steady)
+    throw InputError(c.where("pimple.consistent"), "SIMPLEC (consistent: true) needs timeScheme: steady");
+  if (o.pimple.consistent && o.pimple.relaxVelocity >= 1.0)
+    throw InputError(c.where("pimple.consistent"),
+                     "SIMPLEC (consistent: true) needs relaxVelocity < 1 (0.9 is usual): with 1 its a_P - H1 is the "
+                     "continuity error of the face fluxes, not a coefficient");
   o.pimple.ddtCorrection = c.get<bool>("pimple.ddtCorrection");
   o.pimple.extrapolateGuess = c.get<bool>("pimple.extrapolateGuess");
 

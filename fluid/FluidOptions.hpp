@@ -141,6 +141,12 @@ struct PimpleOptions {
   real outerTolerance = 0.0;
   real relaxVelocity = 1.0;  ///< implicit under-relaxation of momentum (use ~0.7 when steady)
   real relaxPressure = 1.0;  ///< explicit under-relaxation of pressure (use ~0.3 when steady)
+  /// SIMPLEC (steady only): the pressure equation and the velocity correction use
+  /// rAtU = V / (a_P - H1) (a_P the relaxed diagonal, H1 the negated sum of the row's
+  /// off-diagonal coefficients) instead of rAU = V / a_P, with the pressure gradient's part
+  /// of HbyA and phiHbyA moved over to match, so the converged fluxes are SIMPLE's. Neighbour
+  /// corrections the SIMPLE approximation drops are kept, and pressure needs no under-relaxation.
+  bool consistent = false;
   /// Rhie-Chow correction of the time-derivative term (face fluxes remember their own history), so
   /// results do not depend on dt through the interpolation.
   bool ddtCorrection = true;

@@ -107,11 +107,32 @@ KOKKOS_INLINE_FUNCTION real fieldMagnitude(lid_t c, const ConstReal3View& U, con
   return kmath::fabs(U(c, 0)) + kmath::fabs(U(c, 1)) + kmath::fabs(U(c, 2)) + kmath::fabs(p(c));
 }
 
+/// The non-orthogonal part of the face-normal pressure gradient of internal face f (times its
+/// area): (S - deltaCoeff d) . grad p interpolated to the face (the explicit correction).
+KOKKOS_INLINE_FUNCTION real nonOrthogonalPart(lid_t f, lid_t o, lid_t n, real wf, const ConstReal3View& kv,
+                                              const ConstReal3View& gp) {
+  real corr = 0;
+  for (int i = 0; i < 3; ++i) corr += kv(f, i) * (wf * gp(o, i) + (1.0 - wf) * gp(n, i));
+  return corr;
+}
+
 /// Pressure-equation coefficient of internal face f: the face-interpolated rAU over the distance.
 KOKKOS_INLINE_FUNCTION real pressureFaceCoefficient(lid_t f, lid_t o, lid_t n, const ConstRealView& w,
                                                     const ConstRealView& rAU, const ConstRealView& dc) {
   const real wf = w(f);
   return (wf * rAU(o) + (1.0 - wf) * rAU(n)) * dc(f);
+}
+
+/// The under-relaxed momentum diagonal a_P / alpha; the source gets (that - a_P) u_prev, so the
+/// converged solution does not depend on it. `dominant` (steady runs with relaxVelocity < 1)
+/// relaxes max(|a_P|, sum_N |a_PN|) instead, as OpenFOAM's fvMatrix::relax does: where central
+/// convection makes a row lose diagonal dominance (cell Peclet number above 2) the relaxed row
+/// keeps it, which damps the iteration where it would otherwise oscillate (Schaefer-Turek cylinder
+/// on a graded Gmsh mesh: 640 -> see perf/RESULTS.md SIMPLE iterations to 1e-10).
+KOKKOS_INLINE_FUNCTION real relaxedDiagonal(real diag, real sumMagOff, real alpha, bool dominant) {
+  if (!dominant) return diag / alpha;
+  const real d = kmath::fabs(diag);
+  return (d > sumMagOff ? d : sumMagOff) / alpha;
 }
 
 /// One row of FluidSolver::assembleMomentumFused (see there). A named functor rather than a
@@ -121,6 +142,7 @@ struct MomentumRowKernel {
   real rho = 0, mu = 0, rdt = 0, c1 = 0, c0 = 0, c00 = 0, alpha = 1;
   real g[3] = {0, 0, 0};
   bool implicitLinear = true, steady = false, moving = true, old2 = true;
+  bool dominant = false;  ///< relax from max(|a_P|, sum |a_N|) (see relaxedDiagonal)
   lid_t nIn = 0;
   ConstIndexView off, cf, own, cfp, rowPtr, di, kind;
   ConstRealView phi, mp, w, dc, V, V0, V00;
@@ -138,7 +160,7 @@ struct MomentumRowKernel {
   KOKKOS_FORCEINLINE_FUNCTION void operator()(lid_t c, lid_t& firstBad) const {
     for (lid_t k = rowPtr(c); k < rowPtr(c + 1); ++k) vals(k) = 0.0;
     real diag = steady ? 0.0 : rho * c1 * V(c) * rdt;
-    real src[3], bsum[3] = {0.0, 0.0, 0.0};
+    real src[3], bsum[3] = {0.0, 0.0, 0.0}, sumOff = 0.0;
     for (int j = 0; j < 3; ++j) {
       src[j] = rho * V(c) * g[j];
       // c00 = 0: c0 V0 U0 - 0 is c0 V0 U0 (up to the sign of a zero).
@@ -162,6 +184,7 @@ struct MomentumRowKernel {
           od = isOwner ? Fm - D : -Fp - D;
         }
         diag += dg;
+        sumOff += kmath::fabs(od);
         vals(cfp(e)) += od;
       } else {
         // A boundary face's owner is this cell: its flux enters the divergence with +1.
@@ -189,7 +212,7 @@ struct MomentumRowKernel {
       }
     }
     // Implicit under-relaxation: a_P -> a_P / alpha, source += (a_P / alpha - a_P) u_prev.
-    const real ar = diag / alpha;
+    const real ar = relaxedDiagonal(diag, sumOff, alpha, dominant);
     vals(di(c)) = ar;
     if (inv.extent(0) > 0) {
       const real v = 1.0 / ar;
@@ -281,6 +304,8 @@ FluidSolver::FluidSolver(const HexMesh& mesh, const FluidOptions& options)
   MFSI_CHECK(opt_.pimple.nNonOrthogonalCorrectors >= 0, "fluid: nNonOrthogonalCorrectors must be >= 0");
   MFSI_CHECK(opt_.pimple.relaxVelocity > 0 && opt_.pimple.relaxVelocity <= 1, "fluid: relaxVelocity must be in (0, 1]");
   MFSI_CHECK(opt_.pimple.relaxPressure > 0 && opt_.pimple.relaxPressure <= 1, "fluid: relaxPressure must be in (0, 1]");
+  MFSI_CHECK(!opt_.pimple.consistent || (opt_.timeScheme == TimeScheme::Steady && opt_.pimple.relaxVelocity < 1),
+             "fluid: SIMPLEC (consistent) needs timeScheme steady and relaxVelocity < 1");
   MFSI_CHECK(opt_.pressureReferenceCell >= 0 && opt_.pressureReferenceCell < nCells_,
              "fluid: pressureReferenceCell " << opt_.pressureReferenceCell << " is not a cell of the mesh");
   MFSI_CHECK(opt_.artificialCompressibility.soundSpeed >= 0,
@@ -314,6 +339,7 @@ FluidSolver::FluidSolver(const HexMesh& mesh, const FluidOptions& options)
   rhsU_ = Real3View("mfsi::fluid::momentum::rhs", nCells_);
   gradU_ = Tensor3View("mfsi::fluid::gradU", nCells_);
   rAU_ = RealView("mfsi::fluid::rAU", nCells_);
+  if (opt_.pimple.consistent) rAUSimple_ = RealView("mfsi::fluid::rAUSimple", nCells_);
   cellDiag_ = RealView("mfsi::fluid::cellDiag", nCells_);
   rhsP_ = RealView("mfsi::fluid::pressure::rhs", nCells_);
   b_ = RealView("mfsi::fluid::solveB", nCells_);
@@ -936,14 +962,24 @@ FluidSolver::MomentumAssembly FluidSolver::assembleMomentum(bool withB, bool wit
   const real alpha = opt_.pimple.relaxVelocity;
   ConstIndexView di = Au_.diagIdx;
   auto vals = Au_.values;
+  const bool dominant = relaxesDominant();
+  ConstIndexView rp = Au_.rowPtr;
   Kokkos::parallel_for(
       "mfsi::fluid::momentum::relax", RangePolicy(exec_, 0, nCells_), KOKKOS_LAMBDA(lid_t c) {
-        const real a = vals(di(c));
-        const real ar = a / alpha;
-        vals(di(c)) = ar;
+        const lid_t dk = di(c);
+        const real a = vals(dk);
+        real sumOff = 0;
+        if (dominant)
+          for (lid_t k = rp(c); k < rp(c + 1); ++k) sumOff += k == dk ? 0.0 : kmath::fabs(vals(k));
+        const real ar = relaxedDiagonal(a, sumOff, alpha, dominant);
+        vals(dk) = ar;
         for (int j = 0; j < 3; ++j) rhs(c, j) += (ar - a) * U(c, j);
       });
   return {};
+}
+
+bool FluidSolver::relaxesDominant() const {
+  return opt_.timeScheme == TimeScheme::Steady && opt_.pimple.relaxVelocity < 1.0;
 }
 
 void FluidSolver::assembleMomentumFused(bool withB, bool withInv) {
@@ -970,6 +1006,7 @@ void FluidSolver::assembleMomentumFused(bool withB, bool withInv) {
   k.g[1] = opt_.bodyForce[1];
   k.g[2] = opt_.bodyForce[2];
   k.alpha = opt_.pimple.relaxVelocity;
+  k.dominant = relaxesDominant();
   k.nIn = nIn_;
   k.off = mesh_.cellFaceOffsets();
   k.cf = mesh_.cellFaces();
@@ -1007,24 +1044,74 @@ void FluidSolver::computeHbyA(bool withRAU) {
   // H = b - sum_N a_PN u_N (all but the pressure gradient); u = HbyA - rAU grad p, rAU = V / a_P.
   // a_P is read from the row being traversed (both assembly paths store the relaxed diagonal
   // there). rAU depends on a_P alone: the same for every corrector of an outer iteration, so only
-  // the first one writes it.
+  // the first one writes it. SIMPLEC (consistent) also writes rAtU = V / (a_P - H1), H1 the
+  // negated sum of the off-diagonal coefficients, into rAU_ and V / a_P into rAUSimple_. Its
+  // denominator is a_P (1 - alpha) plus the wall terms plus the continuity error of the face
+  // fluxes; it is kept above half of a_P (1 - alpha), its value for a conservative interior row,
+  // so that a transient continuity error cannot make it small or negative.
   ConstIndexView rp = Au_.rowPtr, ci = Au_.colIdx, di = Au_.diagIdx;
   ConstRealView vals = Au_.values, V = geo_.cellVolume;
   ConstReal3View U = U_, rhs = rhsU_;
   auto H = HbyA_;
   auto rAU = rAU_;
+  const bool simplec = opt_.pimple.consistent && withRAU;
+  auto rAUs = rAUSimple_;
+  const real floorFactor = 0.5 * (1.0 - opt_.pimple.relaxVelocity);
   Kokkos::parallel_for(
       "mfsi::fluid::momentum::HbyA", RangePolicy(exec_, 0, nCells_), KOKKOS_LAMBDA(lid_t c) {
         real h[3] = {rhs(c, 0), rhs(c, 1), rhs(c, 2)};
+        real offSum = 0;
         const lid_t dk = di(c);
         for (lid_t k = rp(c); k < rp(c + 1); ++k) {
           if (k == dk) continue;
           const lid_t n = ci(k);
+          offSum += vals(k);
           for (int j = 0; j < 3; ++j) h[j] -= vals(k) * U(n, j);
         }
         const real diag = vals(dk);
         for (int j = 0; j < 3; ++j) H(c, j) = h[j] / diag;
-        if (withRAU) rAU(c) = V(c) / diag;
+        if (simplec) {
+          const real d = diag + offSum, lo = floorFactor * diag;
+          rAUs(c) = V(c) / diag;
+          rAU(c) = V(c) / (d > lo ? d : lo);
+        } else if (withRAU) {
+          rAU(c) = V(c) / diag;
+        }
+      });
+}
+
+void FluidSolver::simplecCorrection() {
+  // SIMPLEC's pressure equation uses rAtU (in rAU_), so the pressure gradient's share that
+  // rAtU - rAU carries moves into HbyA and phiHbyA, with the old pressure: phiHbyA gets
+  // (rAtU - rAU)_f times the face-normal pressure gradient (the matrix's own discretisation:
+  // deltaCoeff times the difference, plus the non-orthogonal part from the cell gradients);
+  // HbyA gets (rAtU - rAU) times the cell gradient. At convergence the fluxes and velocities are
+  // then exactly SIMPLE's (with rAU), so the solution does not depend on the switch.
+  updatePressureGradient();
+  const lid_t nIn = nIn_;
+  ConstIndexView own = mesh_.faceOwner(), nei = mesh_.faceNeighbour(), kind = bc_.kind();
+  ConstRealView w = fd_.weight, dc = fd_.deltaCoeff, rAtU = rAU_, rAUs = rAUSimple_, p = p_, pb = pb_;
+  ConstReal3View kv = fd_.nonOrth, gp = gradP_;
+  const bool nonOrth = nonOrthogonal_;
+  auto phiH = phiHbyA_;
+  Kokkos::parallel_for(
+      "mfsi::fluid::pressure::simplecFlux", RangePolicy(exec_, 0, nFaces_), KOKKOS_LAMBDA(lid_t f) {
+        const lid_t o = own(f);
+        if (f < nIn) {
+          const lid_t n = nei(f);
+          const real wf = w(f);
+          const real dr = wf * (rAtU(o) - rAUs(o)) + (1.0 - wf) * (rAtU(n) - rAUs(n));
+          const real sn = dc(f) * (p(n) - p(o)) + (nonOrth ? nonOrthogonalPart(f, o, n, wf, kv, gp) : 0.0);
+          phiH(f) += dr * sn;
+        } else if (kind(f - nIn) == kFacePressure) {
+          phiH(f) += (rAtU(o) - rAUs(o)) * dc(f) * (pb(f - nIn) - p(o));
+        }
+      });
+  auto H = HbyA_;
+  Kokkos::parallel_for(
+      "mfsi::fluid::momentum::simplecHbyA", RangePolicy(exec_, 0, nCells_), KOKKOS_LAMBDA(lid_t c) {
+        const real dr = rAtU(c) - rAUs(c);
+        for (int j = 0; j < 3; ++j) H(c, j) += dr * gp(c, j);
       });
 }
 
@@ -1255,7 +1342,10 @@ void FluidSolver::assemblePressureMatrixFaces() {
   assembleMatrix(exec_, mesh_, sparsity_, fcP_, cellDiag_, Ap_, opt_.reduction);
 }
 
-bool FluidSolver::fusedPressureSource() const { return opt_.fusedMomentumAssembly && !nonOrthogonal_; }
+bool FluidSolver::fusedPressureSource() const {
+  // SIMPLEC adds its correction to phiHbyA between the flux and the source: the general path.
+  return opt_.fusedMomentumAssembly && !nonOrthogonal_ && !opt_.pimple.consistent;
+}
 
 bool FluidSolver::fusedCellPasses() const {
   return opt_.fusedMomentumAssembly && opt_.reduction == ReductionMode::Gather;
@@ -1339,9 +1429,7 @@ void FluidSolver::pressureSourceFluxFaces() {
             const lid_t n = nei(f);
             const real wf = w(f);
             const real rAUf = wf * rAU(o) + (1.0 - wf) * rAU(n);
-            real corr = 0;
-            for (int i = 0; i < 3; ++i) corr += kv(f, i) * (wf * gp(o, i) + (1.0 - wf) * gp(n, i));
-            fl -= rAUf * corr;
+            fl -= rAUf * nonOrthogonalPart(f, o, n, wf, kv, gp);
           }
           flux(f) = fl;
         } else if (kind(f - nIn) == kFacePressure) {
@@ -1629,6 +1717,7 @@ StepResult FluidSolver::solve() {
     for (int corr = 0; corr < pim.nCorrectors; ++corr) {
       computeHbyA(/*withRAU=*/corr == 0);
       if (!fusedPressureSource()) computePhiHbyA();
+      if (opt_.pimple.consistent) simplecCorrection();
       bc_.updateResistance(exec_, phi_);
       if (hasResistance_) gradPValid_ = false;
       if (pim.relaxPressure < 1.0) Kokkos::deep_copy(exec_, pPrev_, p_);  // read by the relaxation alone

@@ -164,7 +164,11 @@ class FluidSolver {
   };
   MomentumAssembly assembleMomentum(bool withB, bool withInv);
   void assembleMomentumFused(bool withB, bool withInv);
+  /// Steady with relaxVelocity < 1: relax the momentum diagonal from max(|a_P|, sum |a_N|).
+  bool relaxesDominant() const;
   void computeHbyA(bool withRAU);
+  /// SIMPLEC: moves the (rAtU - rAU) grad p part into phiHbyA and HbyA (see there).
+  void simplecCorrection();
   /// The phiHbyA face formula with this step's fields and coefficients (device functor).
   PhiHbyAFace phiHbyAFace() const;
   /// The pressure-flux face formula with this step's fields (device functor).
@@ -230,6 +234,8 @@ class FluidSolver {
   Real3View HbyA_, gradP_, rhsU_;
   Tensor3View gradU_;
   RealView rAU_, cellDiag_, rhsP_, b_;
+  /// SIMPLEC: V / a_P while rAU_ holds rAtU = V / (a_P - H1); allocated when consistent.
+  RealView rAUSimple_;
   Real3View b3_;
   // Face fields.
   RealView phi_, meshPhi_, phiHbyA_, dphi_, dphi0_, dphi00_, sweptNew_, sweptOld_, fluxP_;

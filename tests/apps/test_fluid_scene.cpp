@@ -125,6 +125,44 @@ TEST(FluidScene, MissingViscosityAndPlainPatchWithoutConditionAreErrors) {
   EXPECT_TRUE(contains(e, "fluid.boundary.lid")) << e;
 }
 
+TEST(FluidScene, SimplecNeedsSteadyAndRelaxedMomentum) {
+  std::string yaml = cavityScene(8);
+  yaml.replace(yaml.find("relaxPressure: 0.2"), 18, "relaxPressure: 1, consistent: true");
+  EXPECT_EQ(inputError(yaml), "");
+  std::string transient = yaml;
+  transient.replace(transient.find("timeScheme: steady"), 18, "timeScheme: euler");
+  std::string e = inputError(transient);
+  EXPECT_TRUE(contains(e, "bad.yaml:13:")) << e;
+  EXPECT_TRUE(contains(e, "key 'fluid.pimple.consistent'")) << e;
+  EXPECT_TRUE(contains(e, "needs timeScheme: steady")) << e;
+  std::string unrelaxed = yaml;
+  unrelaxed.replace(unrelaxed.find("relaxVelocity: 0.9"), 18, "relaxVelocity: 1");
+  e = inputError(unrelaxed);
+  EXPECT_TRUE(contains(e, "key 'fluid.pimple.consistent'")) << e;
+  EXPECT_TRUE(contains(e, "relaxVelocity < 1")) << e;
+}
+
+// A steady scene ends after the step whose residuals fell below outerTolerance (20 steps of 100
+// SIMPLE iterations asked for), unless time.stopAtSteadyState is off.
+TEST(FluidScene, SteadyRunStopsWhenConverged) {
+  const auto out = std::filesystem::temp_directory_path() / "mfsi_test_steady_stop";
+  std::filesystem::create_directories(out);
+  auto cfg = mfsi::SceneConfig::fromString(cavityScene(16), "cavity.yaml", mfsi::sceneSchema());
+  mfsi::Simulation sim(cfg);
+  const mfsi::RunResult r = sim.run(out.string(), false);
+  EXPECT_TRUE(r.steadyStateReached);
+  EXPECT_EQ(r.metrics.at("time.steady_state_reached"), 1.0);
+  EXPECT_EQ(r.metrics.at("fluid.converged"), 1.0);
+  EXPECT_LT(r.steps, 20);  // measured 2 (the cavity converges within the second 100 iterations)
+  auto all = mfsi::SceneConfig::fromString(cavityScene(16), "cavity.yaml", mfsi::sceneSchema(),
+                                           {"time.stopAtSteadyState=false"});
+  mfsi::Simulation simAll(all);
+  const mfsi::RunResult rAll = simAll.run(out.string(), false);
+  EXPECT_FALSE(rAll.steadyStateReached);
+  EXPECT_EQ(rAll.steps, 20);
+  EXPECT_EQ(rAll.metrics.count("time.steady_state_reached"), 0u);
+}
+
 TEST(FluidScene, FluidWithoutMeshIsAnError) {
   const std::string e = inputError("time: {endTime: 1, dt: 1}\nfluid: {nu: 0.01}\n");
   EXPECT_TRUE(contains(e, "bad.yaml:2:")) << e;
