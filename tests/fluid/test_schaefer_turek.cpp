@@ -30,12 +30,12 @@ FluidOptions cylinderOptions(bool consistent, double relaxU, double relaxP) {
   o.timeScheme = TimeScheme::Steady;
   o.pimple.nOuterCorrectors = 3000;
   o.pimple.nCorrectors = 1;
-  o.pimple.nNonOrthogonalCorrectors = 1;
+  o.pimple.nNonOrthogonalCorrectors = 0;
   o.pimple.consistent = consistent;
   o.pimple.relaxVelocity = relaxU;
   o.pimple.relaxPressure = relaxP;
   o.pimple.outerTolerance = 1e-10;
-  o.momentumSolver = {1e-12, 0.01, 500};
+  o.momentumSolver = {1e-12, 0.1, 500};
   o.pressureSolver = {1e-12, 0.01, 500};
   PatchBC in;
   in.type = BoundaryType::FixedVelocity;
