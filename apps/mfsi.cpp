@@ -233,6 +233,13 @@ int commandRun(std::string sceneArg, const std::vector<std::string>& sets, std::
     if (result.steadyStateReached && rank == 0)
       std::cout << "steady state reached after step " << result.steps
                 << ": every residual below its tolerance (fluid.pimple.outerTolerance)\n";
+    if (!result.steadyStateMissed.empty()) {
+      summary.status = "unconverged";
+      summary.error = "steady state not reached in " + std::to_string(result.steps) + " steps: " +
+                      result.steadyStateMissed + " (more steps: time.endTime; or time.stopAtSteadyState: false)";
+      std::cerr << "unconverged: " << summary.error << "\n";
+      code = 5;
+    }
     if (result.interruptedBy != 0) {
       summary.status = "interrupted";
       summary.error = std::string("stopped by ") + mfsi::signalName(result.interruptedBy) + " after step " +
@@ -272,7 +279,11 @@ int commandRun(std::string sceneArg, const std::vector<std::string>& sets, std::
   if (rank == 0) {
     try {
       mfsi::writeSummary(out, summary);
-      std::cout << (code == 0 ? "done" : summary.status == "interrupted" ? "interrupted" : "failed") << " in " << summary.wallSeconds << " s; results in " << out
+      std::cout << (code == 0                           ? "done"
+                    : summary.status == "interrupted"   ? "interrupted"
+                    : summary.status == "unconverged" ? "not converged"
+                                                      : "failed")
+                << " in " << summary.wallSeconds << " s; results in " << out
                 << "/ (summary.json)\n";
     } catch (const std::exception& e) {
       // No summary rather than a stale one (a continued run's earlier summary): a run without

@@ -5,6 +5,7 @@
 #include "core/io/HostCopy.hpp"
 
 #include <cmath>
+#include <sstream>
 
 namespace mfsi {
 
@@ -152,8 +153,16 @@ void FluidModule::addOutputFields(io::FieldFrame& frame) {
   }
 }
 
-bool FluidModule::steadyStateReached() const {
-  return solver_.options().timeScheme == fluid::TimeScheme::Steady && last_.converged;
+bool FluidModule::steadyStateReached() const { return solvesSteadyState() && last_.converged; }
+
+bool FluidModule::solvesSteadyState() const { return solver_.options().timeScheme == fluid::TimeScheme::Steady; }
+
+std::string FluidModule::steadyStateGap() const {
+  std::ostringstream s;
+  s << "fluid: the last SIMPLE iteration's initial residuals, momentum " << last_.finalMomentumResidual
+    << " and pressure " << last_.finalPressureResidual << ", are not both below fluid.pimple.outerTolerance "
+    << solver_.options().pimple.outerTolerance;
+  return s.str();
 }
 
 void FluidModule::addMetrics(std::map<std::string, double>& m) const {
@@ -191,6 +200,9 @@ void FluidModule::addMetrics(std::map<std::string, double>& m) const {
     const GhiaErrors e = ghiaErrors(solver_, reports_.ghia.re, reports_.ghia.lidSpeed);
     m["fluid.ghia_u_max_err"] = e.uMax;
     m["fluid.ghia_v_max_err"] = e.vMax;
+    m["fluid.centreline_u_min"] = e.uLineMin;
+    m["fluid.centreline_v_min"] = e.vLineMin;
+    m["fluid.centreline_v_max"] = e.vLineMax;
   }
 }
 

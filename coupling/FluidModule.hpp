@@ -36,6 +36,8 @@ class FluidModule final : public Module {
   void addMetrics(std::map<std::string, double>& metrics) const override;
   /// Steady (timeScheme steady) and the last step's outer loop converged (outerTolerance).
   bool steadyStateReached() const override;
+  bool solvesSteadyState() const override;
+  std::string steadyStateGap() const override;
   /// U and p as cell fields of the scene mesh's grid (and UMean, pMean with fluid.means).
   void addOutputFields(io::FieldFrame& frame) override;
   /// Per step: iteration counts and residuals; each probe's p, Ux, Uy, Uz; each force report's

@@ -55,6 +55,11 @@ class Module {
   /// True when this module solves a steady problem and its last step found it converged (its
   /// residuals below its tolerance): a run whose modules all say so has nothing left to do.
   virtual bool steadyStateReached() const { return false; }
+  /// True when this module solves a steady problem (its steps are iterations towards one state).
+  virtual bool solvesSteadyState() const { return false; }
+  /// For a steady module that has not reached its steady state: what is still off (residuals
+  /// against their tolerance), for the run's message.
+  virtual std::string steadyStateGap() const { return ""; }
   /// Named summary numbers for summary.json ("<module>.<what>").
   virtual void addMetrics(std::map<std::string, double>& /*metrics*/) const {}
   /// Open the module's own output files in the run's output folder (before the first step).

@@ -236,6 +236,10 @@ RunResult Simulation::run(const std::string& outDir, bool terminal, bool continu
       break;
     }
   }
+  if (time_.stopAtSteadyState && !r.steadyStateReached && r.interruptedBy == 0)
+    for (const auto& m : modules_)
+      if (m->solvesSteadyState() && !m->steadyStateReached())
+        r.steadyStateMissed += (r.steadyStateMissed.empty() ? "" : "; ") + m->steadyStateGap();
   if ((r.interruptedBy != 0 || checkpoint_.final) && lastCheckpointStep != ts.step) checkpoint();
   if (fieldOutput_.final && lastFrameStep != ts.step && r.interruptedBy == 0) writeFrame();
   progress.finish();

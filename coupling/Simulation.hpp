@@ -44,6 +44,9 @@ struct RunResult {
   /// Every module reached its steady state (Module::steadyStateReached) after `steps`: the run
   /// stopped there, before time.endTime.
   bool steadyStateReached = false;
+  /// The run asked to stop at its steady state (time.stopAtSteadyState) and has steady modules,
+  /// but reached time.endTime / maxSteps first: what is off ("" when nothing is).
+  std::string steadyStateMissed;
 };
 
 class Simulation {

@@ -115,6 +115,12 @@ GhiaErrors ghiaErrors(const FluidSolver& fluid, int re, double lidSpeed) {
   x.push_back(1.0);
   v.push_back(0.0);
   GhiaErrors e;
+  for (int i = 0; i <= 10000; ++i) {
+    const double t = 1e-4 * i;
+    e.uLineMin = std::min(e.uLineMin, interpCubic(y, u, t));
+    e.vLineMin = std::min(e.vLineMin, interpCubic(x, v, t));
+    e.vLineMax = std::max(e.vLineMax, interpCubic(x, v, t));
+  }
   for (const auto& g : table) {
     if (g.uLine) {
       e.uMax = std::max(e.uMax, std::abs(interpCubic(y, u, g.coord) - g.value));

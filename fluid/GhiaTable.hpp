@@ -29,6 +29,10 @@ struct GhiaErrors {
   /// The same with linear instead of cubic interpolation between the profile samples, which is how
   /// perf/openfoam/cavity_ghia.py samples OpenFOAM's fields (for like-for-like comparisons).
   double uMaxLinear = 0, vMaxLinear = 0;
+  /// Extremes of the interpolated centreline profiles (the same cubic interpolant, sampled every
+  /// 1e-4 of the cavity): smooth functionals of the solution, for mesh studies by Richardson
+  /// extrapolation where Ghia's table (itself from a 129 x 129 grid) is too coarse a reference.
+  double uLineMin = 0, vLineMin = 0, vLineMax = 0;
 };
 
 /// \brief Compare a cavity solution with Ghia's table at `re`. The cavity is the bounding box of

@@ -30,10 +30,11 @@ Rules (README.md says the same):
   when smaller (h = value); any other numeric key (cells, refine, core, rings) is finer when larger
   (h = 1 / value). The observed order p is the least-squares slope of log(error) against log(h).
 - Resume: each run folder holds study_settings.json (scene, its file's SHA-256, --set and the run's
-  settings); a folder whose settings match and whose summary.json says ok, diverged or error is not
+  settings); a folder whose settings match and whose summary.json says ok, diverged, unconverged
+  (a steady run that did not reach its steady state: a row, left out of the fits) or error is not
   run again. The metric and reference are not settings: changing them re-uses every run.
-- Exit codes: 0 done (runs that failed or diverged are rows), 2 bad input (scene, --vary, --set,
-  --reference, a metric no finished run reports, every run refused as bad input), 130 / 143 stopped
+- Exit codes: 0 done (runs that failed, diverged or did not converge are rows), 2 bad input (scene,
+  --vary, --set, --reference, a metric no finished run reports, every run refused as bad input), 130 / 143 stopped
   by SIGINT / SIGTERM (running runs stop after their step; what is done is written; a second signal
   kills them), 1 internal error.
 """
@@ -54,7 +55,7 @@ import sys
 import time
 
 EXIT_OK, EXIT_FAILED, EXIT_BAD_INPUT = 0, 1, 2
-DONE_STATUSES = ("ok", "diverged", "error")
+DONE_STATUSES = ("ok", "diverged", "unconverged", "error")
 THRESHOLDS = (1e-2, 1e-3)  # the cheapest run reaching each error is reported
 KEY_RE = re.compile(r"^[A-Za-z_][A-Za-z0-9_]*(\.[A-Za-z0-9_]+)*$")
 
@@ -241,6 +242,39 @@ def pareto_front(cost, err):
     return front
 
 
+def predict_wall(numeric, categorical, samples, target):
+    """The wall time of a run with settings `target` = (spacings h of the `numeric` keys, {key:
+    value}), from `samples` = [(h, settings, wall)] of the runs done: a power law in the spacings
+    (log time against log 1/h) times a factor per categorical value (`categorical` = [(key,
+    value)], every value of a key but its first: a lumped solver may take 400x Newton's), fitted
+    by least squares when there are enough runs, else with the exponents a 2D mesh (cells ~ n^2),
+    a time step (steps ~ 1/dt) and a tolerance (iterations ~ its digits: exponent 0) usually have."""
+    import numpy as np
+
+    def features(h, settings):
+        if None in h:
+            return None
+        return [1.0] + [-math.log(x) for x in h] + [1.0 if settings.get(n) == v else 0.0 for n, v in categorical]
+
+    fitted = [(features(h, st), w) for h, st, w in samples if features(h, st) is not None]
+    goal = features(*target)
+    if goal is None or not fitted:
+        same = [w for _, st, w in samples if all(st.get(n) == target[1].get(n) for n, _ in categorical)]
+        pool = same or [w for _, _, w in samples]
+        return sum(pool) / len(pool)
+    k = 1 + len(numeric)
+    if len(fitted) >= len(goal) + 1:
+        coef, *_ = np.linalg.lstsq(np.array([f for f, _ in fitted]), np.log([w for _, w in fitted]), rcond=None)
+    else:
+        slopes = np.array([0.0 if re.search(r"tol(erance)?$", n.split("+")[0].split(".")[-1], re.IGNORECASE)
+                           else 1.0 if finer_when_smaller(n) else 2.0 for n in numeric])
+        resid = [(f, math.log(w) - np.dot(f[1:k], slopes)) for f, w in fitted]
+        c0 = np.mean([x for f, x in resid if not any(f[k:])] or [x for _, x in resid])
+        cat = [np.mean([x - c0 for f, x in resid if f[k + i]] or [0.0]) for i in range(len(categorical))]
+        coef = np.concatenate([[c0], slopes, cat])
+    return float(math.exp(np.dot(goal, coef)))
+
+
 def self_test():
     """The fits against synthetic data with known answers; exit 0 when all hold."""
     failures = []
@@ -280,6 +314,19 @@ def self_test():
           parse_vary("mesh.file=a.msh@1, b.msh @ 2") == ("mesh.file", ["mesh.file"], ["a.msh", "b.msh"],
                                                         {"a.msh": 1.0, "b.msh": 2.0}))
     check("Pareto front", pareto_front([1, 2, 3, 4, 5], [0.5, 0.6, 0.1, 0.1, 0.01]) == [0, 2, 4])
+    # ETA: a tolerance (numeric) by a method (categorical) as in the hencky solver study, where the
+    # lumped method takes ~400x Newton's time: predictions stay with their method's runs.
+    tol, cat = ["membranes.0.solver.tolerance"], [("membranes.0.solver.method", "newton")]
+    done = [([1e-3], {"membranes.0.solver.method": "lumped"}, 8.0), ([1e-3], {"membranes.0.solver.method": "newton"}, 0.02),
+            ([1e-4], {"membranes.0.solver.method": "lumped"}, 16.0)]
+    lumped = predict_wall(tol, cat, done, ([1e-6], {"membranes.0.solver.method": "lumped"}))
+    newton = predict_wall(tol, cat, done, ([1e-6], {"membranes.0.solver.method": "newton"}))
+    check(f"predicted wall times by method: lumped {lumped:.3g} s in [8, 100], newton {newton:.3g} s in [0.01, 0.2]",
+          8 <= lumped <= 100 and 0.01 <= newton <= 0.2)
+    mesh = ["mesh.refine"]
+    done = [([1 / r], {}, 0.1 * r ** 2) for r in (1, 2, 4)]
+    w = predict_wall(mesh, [], done, ([1 / 8], {}))
+    check(f"predicted wall time of a mesh refinement from t ~ n^2: {w:.4g} s (6.4)", abs(w - 6.4) < 1e-6)
     print("self-test " + ("passed" if not failures else f"FAILED ({len(failures)})"))
     return EXIT_OK if not failures else EXIT_FAILED
 
@@ -568,29 +615,17 @@ class Study:
             self.status_shown = False
 
     def predicted_wall(self, run, done):
-        """The time a run is expected to take: a power law in the numeric settings fitted to the runs
-        done (log time against log 1/h), else their mean."""
-        import numpy as np
-
+        """The time a run is expected to take (predict_wall), from the runs done."""
         walls = [r.process_s or r.summary.get("wall_s") for r in done]  # start-up included: what the study waits
         pts = [(r, w) for r, w in zip(done, walls) if isinstance(w, (int, float)) and w > 0]
         if not pts:
             return None
+        categorical = [(n, v) for n, _, vals, _ in self.vary if n not in self.numeric for v in vals[1:]]
 
-        def features(r):
-            h = [self.h(r, n) for n in self.numeric]
-            return None if None in h else [1.0] + [-math.log(x) for x in h]
+        def sample(r):
+            return [self.h(r, n) for n in self.numeric], r.settings
 
-        fitted = [(features(r), w) for r, w in pts if features(r) is not None]
-        if not self.numeric or features(run) is None or not fitted:
-            return sum(w for _, w in pts) / len(pts)
-        if len(fitted) >= len(self.numeric) + 2:
-            coef, *_ = np.linalg.lstsq(np.array([f for f, _ in fitted]), np.log([w for _, w in fitted]), rcond=None)
-        else:  # too few runs to fit the exponents: a 2D mesh's (cells ~ n^2) and a time step's (steps ~ 1/dt)
-            slopes = np.array([1.0 if finer_when_smaller(n) else 2.0 for n in self.numeric])
-            c0 = np.mean([math.log(w) - np.dot(f[1:], slopes) for f, w in fitted])
-            coef = np.concatenate([[c0], slopes])
-        return float(math.exp(np.dot(features(run), coef)))
+        return predict_wall(self.numeric, categorical, [sample(r) + (w,) for r, w in pts], sample(run))
 
     def eta(self, pending, running, done):
         total = 0.0

@@ -72,6 +72,13 @@ TEST(FluidScene, CavityAtN16MatchesGhiaAndUpwindOverrideIsWorse) {
   // lines: more than twice as far), a wrong viscosity or a mis-read lid velocity break these bounds.
   EXPECT_LT(eu, 0.03);
   EXPECT_LT(ev, 0.02);
+  // The extremes of the centreline profiles, against Ghia's extreme table entries (u -0.21090 at
+  // y = 0.4531, v 0.17527 at x = 0.2344, -0.24533 at x = 0.8047); N = 16 is 0.019 off at most.
+  std::printf("cavity scene N=16: centreline u min %.5f, v max %.5f, v min %.5f\n", m.at("fluid.centreline_u_min"),
+              m.at("fluid.centreline_v_max"), m.at("fluid.centreline_v_min"));
+  EXPECT_NEAR(m.at("fluid.centreline_u_min"), -0.21090, 0.025);  // measured -0.19222
+  EXPECT_NEAR(m.at("fluid.centreline_v_max"), 0.17527, 0.025);  // 0.16195
+  EXPECT_NEAR(m.at("fluid.centreline_v_min"), -0.24533, 0.025);  // -0.23909
   // The --set override reaches the solver: first-order upwind is clearly worse.
   const auto up = runScene(cavityScene(16), {"fluid.convection=upwind"});
   const double eUp = std::max(up.at("fluid.ghia_u_max_err"), up.at("fluid.ghia_v_max_err"));

@@ -27,3 +27,22 @@ if(NOT rows EQUAL steps)
   message(SEND_ERROR "steps.csv has ${rows} steps, summary.json says ${steps}")
 endif()
 message(STATUS "diverged after ${steps} steps at t = ${simTime}: ${err}")
+
+# A steady run that ends before its steady state: exit 5, status "unconverged", the residuals that
+# are still too large named; with time.stopAtSteadyState off the same run is an ordinary run.
+set(out ${WORK}/cylinder_short)
+execute_process(COMMAND ${MFSI} run ${CASES}/cylinder.yaml --set fluid.pimple.outerCorrectors=5 --set time.endTime=2
+  --out ${out} --threads 1 RESULT_VARIABLE rc OUTPUT_QUIET ERROR_VARIABLE e)
+if(NOT rc EQUAL 5)
+  message(FATAL_ERROR "exit code ${rc}, expected 5 (unconverged)\n${e}")
+endif()
+mfsi_expect_summary(${out} unconverged "outerTolerance" "cylinder stopped after 10 SIMPLE iterations")
+if(NOT summary_steps EQUAL 2)
+  message(SEND_ERROR "steps ${summary_steps}: expected the 2 steps asked for")
+endif()
+execute_process(COMMAND ${MFSI} run ${CASES}/cylinder.yaml --set fluid.pimple.outerCorrectors=5 --set time.endTime=2
+  --set time.stopAtSteadyState=false --out ${out} --overwrite --threads 1 RESULT_VARIABLE rc OUTPUT_QUIET
+  ERROR_VARIABLE e)
+if(NOT rc EQUAL 0)
+  message(FATAL_ERROR "exit code ${rc} with time.stopAtSteadyState=false, expected 0\n${e}")
+endif()
