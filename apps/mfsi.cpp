@@ -348,7 +348,7 @@ int main(int argc, char** argv) {
   study->add_option("--metric", studyOptions.metric, "the metric of summary.json to compare");
   study->add_option("--reference", studyOptions.reference,
                     "exact (the metric's <NAME>_exact), exact:METRIC, finest (the finest run; Richardson "
-                    "estimate of the limit) or a number");
+                    "estimate of the limit), richardson (that limit) or a number");
   study->add_option("--jobs", studyOptions.jobs, "runs at once (default 1)")->check(CLI::PositiveNumber);
   study
       ->add_option("--threads", studyOptions.threads,
@@ -369,7 +369,7 @@ int main(int argc, char** argv) {
     if (!studyOptions.selfTest && (studyOptions.scene.empty() || studyOptions.vary.empty() ||
                                    studyOptions.metric.empty() || studyOptions.reference.empty())) {
       std::cerr << "error: mfsi study needs SCENE, --vary KEY=V1,V2,..., --metric NAME and --reference "
-                   "exact|exact:METRIC|finest|VALUE (see mfsi study --help)\n";
+                   "exact|exact:METRIC|finest|richardson|VALUE (see mfsi study --help)\n";
       return 2;
     }
     return commandStudy(studyOptions);

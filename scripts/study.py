@@ -23,7 +23,8 @@ Rules (README.md says the same):
   exact:KEY names it (membrane.centreDeflection against exact:membrane.hencky_w0_exact). A number: that
   value (0 for metrics that are errors already, such as fluid.ghia_u_max_err). finest: the run with
   the finest value of the first numeric varied key among the runs that share the other keys' values;
-  Richardson extrapolation from the three finest estimates the limit.
+  Richardson extrapolation from the three finest estimates the limit. richardson: that limit is the
+  reference, so the finest run has an error of its own (the finest run where no limit fits).
 - error = |metric - reference| / |reference| (relative), |metric - reference| when the reference is 0.
 - Resolution: a value is numeric when it is a number or a vector of numbers (its largest component:
   cells [32,32,1] -> 32). A key whose last part is dt or deltaT or ends in tol / tolerance is finer
@@ -148,12 +149,12 @@ def parse_reference(text):
         if not KEY_RE.match(key):
             raise BadInput(f"--reference '{text}': expected exact:METRIC_NAME")
         return {"kind": "exact", "key": key}
-    if text == "finest":
-        return {"kind": "finest"}
+    if text in ("finest", "richardson"):
+        return {"kind": text}
     try:
         value = float(text)
     except ValueError:
-        raise BadInput(f"--reference '{text}': expected exact, exact:METRIC, finest or a number") from None
+        raise BadInput(f"--reference '{text}': expected exact, exact:METRIC, finest, richardson or a number") from None
     if not math.isfinite(value):
         raise BadInput(f"--reference '{text}': not a finite number")
     return {"kind": "value", "value": value}
@@ -475,9 +476,9 @@ class Study:
         self.numeric = [n for n, _, vals, _ in self.vary
                         if all(self.level(n, v) is not None for v in vals)
                         and len({self.level(n, v) for v in vals if self.level(n, v) > 0}) > 1]
-        if self.reference["kind"] == "finest" and not self.numeric:
-            raise BadInput("--reference finest needs a numeric --vary (cells, mesh.refine, time.dt, ...) with at "
-                           "least two positive values: its finest value is the reference")
+        if self.reference["kind"] in ("finest", "richardson") and not self.numeric:
+            raise BadInput(f"--reference {self.reference['kind']} needs a numeric --vary (cells, mesh.refine, "
+                           "time.dt, ...) with at least two positive values: its finest value is the reference")
         total = args.threads
         if total is None:
             env = os.environ.get("OMP_NUM_THREADS", "")
@@ -745,11 +746,21 @@ class Study:
                 hint = [n for n in names if "exact" in n or n.endswith("_w0")] or names
                 return (f"--reference exact: no run reports '{key}', the exact value of {self.metric}; name "
                         f"it with --reference exact:METRIC (candidates: {', '.join(hint)})")
-        else:  # finest: per group of the other varied keys, the finest value of the resolution key
+        else:  # finest / richardson: per group of the other varied keys, along the resolution key
             key = self.numeric[0]
             for members in self.groups(key, self.resolved(key, with_metric)).values():
                 finest = min(members, key=lambda r: self.h(r, key))
-                finest.values["message"] = "the reference (the finest run)"
+                if kind == "richardson":
+                    three = sorted(members, key=lambda r: self.h(r, key))[:3]
+                    ext = richardson([self.h(r, key) for r in three], [r.values["metric"] for r in three]) \
+                        if len(three) == 3 else {"reason": "fewer than three runs"}
+                    if "limit" in ext:
+                        for r in members:
+                            r.values["reference"] = ext["limit"]
+                        continue
+                    finest.values["message"] = f"the reference (the finest run: no Richardson limit, {ext['reason']})"
+                else:
+                    finest.values["message"] = "the reference (the finest run)"
                 for r in members:
                     r.values["reference"] = finest.values["metric"]
         for r in with_metric:
@@ -821,7 +832,7 @@ class Study:
                 p, c = observed_order(h, [r.values["error"] for r in members])
                 orders.append({"key": key, "series": dict(group), "order": p, "constant": c,
                                "runs": [r.id for r in members]})
-        if self.reference["kind"] == "finest":
+        if self.reference["kind"] in ("finest", "richardson"):
             key = self.numeric[0]
             ok = [r for r in self.runs if r.status == "ok" and r.values.get("metric") is not None]
             for group, members in self.groups(key, self.resolved(key, ok)).items():
@@ -841,8 +852,8 @@ class Study:
         out = []
         pts = [r for r in self.runs if r.status == "ok" and r.values.get("error") is not None
                and isinstance((r.summary or {}).get("wall_s"), (int, float))]
-        if self.reference["kind"] == "finest":  # the reference runs have no error of their own
-            pts = [r for r in pts if not r.values["message"].startswith("the reference")]
+        # The reference runs (finest, or richardson without a limit) have no error of their own.
+        pts = [r for r in pts if not r.values["message"].startswith("the reference")]
         for thr in THRESHOLDS:
             good = [r for r in pts if r.values["error"] <= thr]
             best = min(good, key=lambda r: r.summary["wall_s"]) if good else None
@@ -883,7 +894,8 @@ class Study:
             return []
         files = []
         relative = self.reference["kind"] != "value" or self.reference["value"] != 0
-        ref_text = {"exact": "exact value", "finest": "finest run", "value": "reference value"}[self.reference["kind"]]
+        ref_text = {"exact": "exact value", "finest": "finest run", "richardson": "Richardson limit",
+                    "value": "reference value"}[self.reference["kind"]]
         ylabel = f"{'relative ' if relative else ''}error of {self.metric}"
 
         def label(r, skip=None):
@@ -1027,7 +1039,7 @@ def main(argv):
     ap.add_argument("--vary", action="append", default=[], help="KEY=V1,V2,... (repeatable: the product grid)")
     ap.add_argument("--set", action="append", default=[], help="KEY=VALUE for every run (repeatable)")
     ap.add_argument("--metric", help="metric of summary.json")
-    ap.add_argument("--reference", default="exact", help="exact | exact:KEY | finest | a number")
+    ap.add_argument("--reference", default="exact", help="exact | exact:KEY | finest | richardson | a number")
     ap.add_argument("--jobs", type=int, default=1, help="runs at once")
     ap.add_argument("--threads", type=int, default=None, help="threads of the whole study (split between the jobs)")
     ap.add_argument("--out", help="study folder (default results/<scene>-study)")

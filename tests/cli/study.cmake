@@ -40,7 +40,7 @@ expect_bad_input("--vary without values" "--vary 'mesh.refine': expected KEY=V1,
   cavity --vary mesh.refine --metric fluid.ghia_u_max_err --reference 0)
 expect_bad_input("unknown scene" "scene 'no-such-scene': cannot open scene file"
   no-such-scene --vary mesh.refine=1,2 --metric fluid.ghia_u_max_err --reference 0)
-expect_bad_input("bad --reference" "--reference 'closest': expected exact, exact:METRIC, finest or a number"
+expect_bad_input("bad --reference" "--reference 'closest': expected exact, exact:METRIC, finest, richardson or a number"
   cavity --vary mesh.refine=1,2 --metric fluid.ghia_u_max_err --reference closest)
 expect_bad_input("finest without a numeric key" "--reference finest needs a numeric --vary"
   cavity --vary fluid.convection=upwind,linear --metric fluid.ghia_u_max_err --reference finest)
@@ -109,6 +109,22 @@ execute_process(COMMAND ${study} --vary ${cells}=[4,4],[6,6],[8,8],[0,0] RESULT_
   ERROR_VARIABLE e)
 if(NOT rc EQUAL 0 OR NOT o MATCHES "4 done already \\(reused\\), 0 to run")
   message(SEND_ERROR "a finished study run again: exit ${rc} (expected 0 and nothing to run):\n${o}\n${e}")
+endif()
+# Against the Richardson limit of the three finest runs (no run again): every run has an error,
+# the finest too, and the limit is the exact period's to the time step's error (0.2 %).
+string(REPLACE "--reference;exact" "--reference;richardson" rich "${study}")
+execute_process(COMMAND ${rich} --vary ${cells}=[4,4],[6,6],[8,8] RESULT_VARIABLE rc OUTPUT_VARIABLE o ERROR_VARIABLE e)
+if(NOT rc EQUAL 0 OR NOT o MATCHES "0 to run" OR NOT o MATCHES "Richardson limit of membrane.period")
+  message(SEND_ERROR "--reference richardson: exit ${rc} (expected 0, nothing run, the limit):\n${o}\n${e}")
+endif()
+file(READ ${out}/study.json json)
+string(JSON limit GET "${json}" richardson 0 limit)
+if(limit LESS 0.1400 OR limit GREATER 0.1428)
+  message(SEND_ERROR "Richardson limit of the period ${limit}: expected the exact 0.14142 within 1 %")
+endif()
+file(STRINGS ${out}/study.csv rows)
+if(NOT rows MATCHES "cells=8x8,\"\\[8,8\\]\",ok,[^;]*,0\\.14[0-9]+,0\\.14[0-9]+,0\\.00[1-9]")
+  message(SEND_ERROR "study.csv: the finest run (8x8) has no error of its own against the limit:\n${rows}")
 endif()
 string(REPLACE "membrane.period" "membrane.perod" typo "${study}")
 execute_process(COMMAND ${typo} --vary ${cells}=[4,4],[6,6],[8,8] RESULT_VARIABLE rc OUTPUT_VARIABLE o ERROR_VARIABLE e)
