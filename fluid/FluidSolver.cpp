@@ -123,12 +123,12 @@ KOKKOS_INLINE_FUNCTION real pressureFaceCoefficient(lid_t f, lid_t o, lid_t n, c
   return (wf * rAU(o) + (1.0 - wf) * rAU(n)) * dc(f);
 }
 
-/// The under-relaxed momentum diagonal a_P / alpha; the source gets (that - a_P) u_prev, so the
-/// converged solution does not depend on it. `dominant` (steady runs with relaxVelocity < 1)
-/// relaxes max(|a_P|, sum_N |a_PN|) instead, as OpenFOAM's fvMatrix::relax does: where central
-/// convection makes a row lose diagonal dominance (cell Peclet number above 2) the relaxed row
-/// keeps it, which damps the iteration where it would otherwise oscillate (Schaefer-Turek cylinder
-/// on a graded Gmsh mesh: 640 -> see perf/RESULTS.md SIMPLE iterations to 1e-10).
+/// The under-relaxed momentum diagonal a_P / alpha; the source gets (that - a_P) u_prev and the
+/// face fluxes the matching Rhie-Chow term (storeRelaxationFlux), so the converged solution does not
+/// depend on it. `dominant` (relaxVelocity < 1) relaxes max(|a_P|, sum_N |a_PN|) instead, as
+/// OpenFOAM's fvMatrix::relax does: where central convection makes a row lose diagonal dominance
+/// (cell Peclet number above 2, or a Courant number well above 1) the relaxed row keeps it. Without
+/// it SIMPLE broke down on a graded Gmsh cylinder mesh and stalled on the fine block mesh.
 KOKKOS_INLINE_FUNCTION real relaxedDiagonal(real diag, real sumMagOff, real alpha, bool dominant) {
   if (!dominant) return diag / alpha;
   const real d = kmath::fabs(diag);
@@ -143,6 +143,7 @@ struct MomentumRowKernel {
   real g[3] = {0, 0, 0};
   bool implicitLinear = true, steady = false, moving = true, old2 = true;
   bool dominant = false;  ///< relax from max(|a_P|, sum |a_N|) (see relaxedDiagonal)
+  RealView frac;          ///< when not empty: 1 - a_P / (relaxed a_P), for the Rhie-Chow relaxation term
   lid_t nIn = 0;
   ConstIndexView off, cf, own, cfp, rowPtr, di, kind;
   ConstRealView phi, mp, w, dc, V, V0, V00;
@@ -214,6 +215,7 @@ struct MomentumRowKernel {
     // Implicit under-relaxation: a_P -> a_P / alpha, source += (a_P / alpha - a_P) u_prev.
     const real ar = relaxedDiagonal(diag, sumOff, alpha, dominant);
     vals(di(c)) = ar;
+    if (frac.extent(0) > 0) frac(c) = ar != 0.0 ? 1.0 - diag / ar : 0.0;
     if (inv.extent(0) > 0) {
       const real v = 1.0 / ar;
       const bool ok = ar != 0.0 && v - v == 0.0;  // v - v != 0 for inf and NaN
@@ -340,6 +342,10 @@ FluidSolver::FluidSolver(const HexMesh& mesh, const FluidOptions& options)
   gradU_ = Tensor3View("mfsi::fluid::gradU", nCells_);
   rAU_ = RealView("mfsi::fluid::rAU", nCells_);
   if (opt_.pimple.consistent) rAUSimple_ = RealView("mfsi::fluid::rAUSimple", nCells_);
+  if (opt_.pimple.relaxVelocity < 1.0) {
+    relaxFraction_ = RealView("mfsi::fluid::relaxFraction", nCells_);
+    relaxFlux_ = RealView("mfsi::fluid::relaxFlux", nFaces_);
+  }
   cellDiag_ = RealView("mfsi::fluid::cellDiag", nCells_);
   rhsP_ = RealView("mfsi::fluid::pressure::rhs", nCells_);
   b_ = RealView("mfsi::fluid::solveB", nCells_);
@@ -964,6 +970,7 @@ FluidSolver::MomentumAssembly FluidSolver::assembleMomentum(bool withB, bool wit
   auto vals = Au_.values;
   const bool dominant = relaxesDominant();
   ConstIndexView rp = Au_.rowPtr;
+  const RealView frac = relaxFraction_;
   Kokkos::parallel_for(
       "mfsi::fluid::momentum::relax", RangePolicy(exec_, 0, nCells_), KOKKOS_LAMBDA(lid_t c) {
         const lid_t dk = di(c);
@@ -973,13 +980,43 @@ FluidSolver::MomentumAssembly FluidSolver::assembleMomentum(bool withB, bool wit
           for (lid_t k = rp(c); k < rp(c + 1); ++k) sumOff += k == dk ? 0.0 : kmath::fabs(vals(k));
         const real ar = relaxedDiagonal(a, sumOff, alpha, dominant);
         vals(dk) = ar;
+        if (frac.extent(0) > 0) frac(c) = ar != 0.0 ? 1.0 - a / ar : 0.0;
         for (int j = 0; j < 3; ++j) rhs(c, j) += (ar - a) * U(c, j);
       });
   return {};
 }
 
+void FluidSolver::storeRelaxationFlux() {
+  // The iterate the relaxation pulls towards (u_prev in the source (a_P / alpha - a_P) u_prev): its
+  // face fluxes minus its interpolated velocity, read by the Rhie-Chow interpolation of HbyA
+  // (PhiHbyAFace) with the weight 1 - a_P / (relaxed a_P), as the time term's old fluxes are. At a
+  // converged iterate the relaxation then drops out of the fluxes as it does out of the cell
+  // velocities: the steady cylinder's c_D and fields at relaxVelocity 0.7 and 0.9 agree to 1e-10,
+  // a transient cavity's steps with U 0.7 / p 0.5 and unrelaxed to 2e-9 (6e-2 without it).
+  // On a fixed-pressure boundary face (whose flux is H . S of the owner) the owner's velocity
+  // stands for the interpolated one.
+  ConstIndexView own = mesh_.faceOwner(), nei = mesh_.faceNeighbour(), kind = bc_.kind();
+  ConstRealView w = fd_.weight, phi = phi_;
+  ConstReal3View U = U_, sf = geo_.faceArea;
+  auto d = relaxFlux_;
+  const lid_t nIn = nIn_;
+  Kokkos::parallel_for(
+      "mfsi::fluid::momentum::relaxFlux", RangePolicy(exec_, 0, nFaces_), KOKKOS_LAMBDA(lid_t f) {
+        const lid_t o = own(f);
+        if (f < nIn) {
+          d(f) = ddtCorrectionFlux(f, o, nei(f), w, phi(f), U, sf);
+        } else if (kind(f - nIn) == kFacePressure) {
+          real s = 0;
+          for (int k = 0; k < 3; ++k) s += U(o, k) * sf(f, k);
+          d(f) = phi(f) - s;
+        } else {
+          d(f) = 0.0;
+        }
+      });
+}
+
 bool FluidSolver::relaxesDominant() const {
-  return opt_.timeScheme == TimeScheme::Steady && opt_.pimple.relaxVelocity < 1.0;
+  return opt_.pimple.relaxVelocity < 1.0;
 }
 
 void FluidSolver::assembleMomentumFused(bool withB, bool withInv) {
@@ -1007,6 +1044,7 @@ void FluidSolver::assembleMomentumFused(bool withB, bool withInv) {
   k.g[2] = opt_.bodyForce[2];
   k.alpha = opt_.pimple.relaxVelocity;
   k.dominant = relaxesDominant();
+  k.frac = relaxFraction_;
   k.nIn = nIn_;
   k.off = mesh_.cellFaceOffsets();
   k.cf = mesh_.cellFaces();
@@ -1130,6 +1168,10 @@ struct PhiHbyAFace {
   ConstReal3View sf, H;
   real rho = 0, rdt = 0, c0 = 0, c00 = 0;
   bool ddt = false, old2 = false;
+  /// Rhie-Chow consistent with the under-relaxation: (1 - a_P / relaxed a_P) interpolated, times
+  /// the previous iterate's face flux minus its interpolated velocity (relaxFlux).
+  bool relax = false;
+  ConstRealView frac, dRelax;
   KOKKOS_INLINE_FUNCTION real operator()(lid_t f) const {
     const lid_t o = own(f);
     if (f < nIn) {
@@ -1137,6 +1179,7 @@ struct PhiHbyAFace {
       const real wf = w(f);
       real s = 0;
       for (int k = 0; k < 3; ++k) s += (wf * H(o, k) + (1.0 - wf) * H(n, k)) * sf(f, k);
+      if (relax) s += (wf * frac(o) + (1.0 - wf) * frac(n)) * dRelax(f);
       if (ddt) {
         // Rhie-Chow consistent with the time term: the old-time part of H enters through the old
         // face fluxes rather than the interpolated old cell velocities.
@@ -1148,6 +1191,7 @@ struct PhiHbyAFace {
     if (kind(f - nIn) != kFacePressure) return phi(f);  // prescribed flux
     real hs = 0;
     for (int k = 0; k < 3; ++k) hs += H(o, k) * sf(f, k);
+    if (relax) hs += frac(o) * dRelax(f);
     return hs;
   }
 };
@@ -1172,6 +1216,9 @@ PhiHbyAFace FluidSolver::phiHbyAFace() const {
   F.ddt = opt_.pimple.ddtCorrection && opt_.timeScheme != TimeScheme::Steady;
   // Euler (and BDF2's first step) has c00 = 0: the second old level adds an exact zero.
   F.old2 = c00_ != 0.0;
+  F.relax = relaxFraction_.extent(0) > 0;
+  F.frac = relaxFraction_;
+  F.dRelax = relaxFlux_;
   return F;
 }
 
@@ -1685,6 +1732,7 @@ StepResult FluidSolver::solve() {
     if (gradUCurrent_) computeVelocityGradient();
     // The fused assembly also forms the solve's right-hand side when the pressure gradient is
     // already current (the usual case: nothing changed it since the last corrector).
+    if (relaxFlux_.extent(0) > 0) storeRelaxationFlux();
     const MomentumAssembly formed =
         assembleMomentum(/*withB=*/pim.momentumPredictor && gradPValid_, /*withInv=*/pim.momentumPredictor);
     const bool bReady = formed.b;

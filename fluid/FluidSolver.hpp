@@ -164,8 +164,10 @@ class FluidSolver {
   };
   MomentumAssembly assembleMomentum(bool withB, bool withInv);
   void assembleMomentumFused(bool withB, bool withInv);
-  /// Steady with relaxVelocity < 1: relax the momentum diagonal from max(|a_P|, sum |a_N|).
+  /// relaxVelocity < 1: relax the momentum diagonal from max(|a_P|, sum |a_N|).
   bool relaxesDominant() const;
+  /// relaxFlux_ from the current face fluxes and velocity (before the momentum solve).
+  void storeRelaxationFlux();
   void computeHbyA(bool withRAU);
   /// SIMPLEC: moves the (rAtU - rAU) grad p part into phiHbyA and HbyA (see there).
   void simplecCorrection();
@@ -236,6 +238,9 @@ class FluidSolver {
   RealView rAU_, cellDiag_, rhsP_, b_;
   /// SIMPLEC: V / a_P while rAU_ holds rAtU = V / (a_P - H1); allocated when consistent.
   RealView rAUSimple_;
+  /// Under-relaxed momentum (relaxVelocity < 1): 1 - a_P / relaxed a_P per cell, and the face flux
+  /// minus the interpolated velocity of the iterate the relaxation pulls towards (storeRelaxationFlux).
+  RealView relaxFraction_, relaxFlux_;
   Real3View b3_;
   // Face fields.
   RealView phi_, meshPhi_, phiHbyA_, dphi_, dphi0_, dphi00_, sweptNew_, sweptOld_, fluxP_;
