@@ -44,12 +44,8 @@ Fields run(const HexMesh& mesh, double relaxU, double relaxP, int steps) {
     EXPECT_TRUE(r.ok && r.converged) << "step " << s << " relax " << relaxU << " / " << relaxP;
     out.outerIterations += r.outerIterations;
   }
-  const auto U = Kokkos::create_mirror_view_and_copy(HostSpace(), fluid.velocity());
-  const auto p = Kokkos::create_mirror_view_and_copy(HostSpace(), fluid.pressure());
-  for (std::size_t i = 0; i < U.extent(0); ++i) {
-    for (int c = 0; c < 3; ++c) out.U[c].push_back(U(i, c));
-    out.p.push_back(p(i));
-  }
+  for (int c = 0; c < 3; ++c) out.U[c] = test::column(fluid.velocity(), c);
+  out.p = test::host(fluid.pressure());
   return out;
 }
 

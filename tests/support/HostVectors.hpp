@@ -20,6 +20,20 @@ inline HostVec host(const RealView& v) {
   return HostVec(h.data(), h.data() + h.extent(0));
 }
 
+/// Host copy of a read-only device vector (a solver's field).
+inline HostVec host(const ConstRealView& v) {
+  auto h = Kokkos::create_mirror_view_and_copy(HostSpace(), v);
+  return HostVec(h.data(), h.data() + h.extent(0));
+}
+
+/// Column c of a read-only n x 3 device multi-vector (a solver's velocity).
+inline HostVec column(const ConstReal3View& v, int c) {
+  auto h = Kokkos::create_mirror_view_and_copy(HostSpace(), v);
+  HostVec out(h.extent(0));
+  for (std::size_t i = 0; i < out.size(); ++i) out[i] = h(i, c);
+  return out;
+}
+
 /// Device copy of a host vector.
 inline RealView device(const HostVec& v) {
   RealView d("test::vec", v.size());
