@@ -340,7 +340,9 @@ void FsiCoupling::solveStructure(double t1, double dt) {
     if (!rep.converged || !std::isfinite(rep.relativeResidual)) {
       std::ostringstream os;
       os << p.module->name() << ": the structure solve did not converge in the step to t = " << t1 << " ("
-         << rep.iterations << " iterations, relative residual " << rep.relativeResidual << ")";
+         << (last_.iterations == 0 ? std::string("the predictor on the loads of t_n")
+                                   : "coupling iteration " + std::to_string(last_.iterations))
+         << "; " << rep.iterations << " Newton iterations, relative residual " << rep.relativeResidual << ")";
       throw DivergenceError(os.str());
     }
   }
