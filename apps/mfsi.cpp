@@ -18,7 +18,9 @@
 // Every `run` writes <out>/summary.json (also on errors), <out>/scene.yaml and <out>/steps.csv (and
 // fields.xdmf with fields/ as the scene's `output` asks); a folder that holds an earlier run's
 // results is refused (exit 2, nothing written) unless --overwrite.
+#include "Partition.hpp"
 #include "Plot.hpp"
+#include "SceneFiles.hpp"
 #include "Study.hpp"
 #include "coupling/Simulation.hpp"
 #include "core/Interrupt.hpp"
@@ -48,6 +50,8 @@ std::vector<fs::path> caseDirs() {
   return dirs;
 }
 
+}  // namespace
+
 /// A path to a scene file, or the name of a built-in scene.
 fs::path resolveScene(const std::string& arg) {
   if (fs::exists(arg) && !fs::is_directory(arg)) return arg;
@@ -62,6 +66,8 @@ std::string sceneName(const mfsi::SceneConfig& cfg, const fs::path& file) {
   const std::string n = cfg.get<std::string>("name");
   return n.empty() ? file.stem().string() : n;
 }
+
+namespace {
 
 int threadCount() { return mfsi::ExecSpace().concurrency(); }
 
@@ -328,6 +334,15 @@ int main(int argc, char** argv) {
 
   app.add_subcommand("scenes", "list the built-in scenes");
 
+  int partitionRanks = 0;
+  std::string partitionOut;
+  auto* partition = app.add_subcommand(
+      "partition", "decompose a scene's mesh over N ranks (METIS, membranes' cells kept together): figures and the map");
+  partition->add_option("scene", scene, "scene file, or the name of a built-in scene")->required();
+  partition->add_option("-n,--ranks", partitionRanks, "number of ranks")->required()->check(CLI::PositiveNumber);
+  partition->add_option("--set", sets, "override a scene value: --set a.b.c=value (repeatable)")->allow_extra_args(false);
+  partition->add_option("--out", partitionOut, "file of the cell -> rank map (default: results/<scene>-partition<N>.txt)");
+
   std::string plotDir, plotOut;
   auto* plot = app.add_subcommand("plot", "PNGs of a run folder's time series (and, for a 2D scene, its last field)");
   plot->add_option("run_dir", plotDir, "a folder written by `mfsi run`")->required();
@@ -394,7 +409,22 @@ int main(int argc, char** argv) {
     for (auto& a : kargs) kargv.push_back(a.data());
     int kargc = static_cast<int>(kargv.size());
     Kokkos::ScopeGuard kokkos(kargc, kargv.data());
-    if (app.got_subcommand("run")) {
+    int worldSize = 1, worldRank = 0;
+    if (mpi) {
+      MPI_Comm_size(MPI_COMM_WORLD, &worldSize);
+      MPI_Comm_rank(MPI_COMM_WORLD, &worldRank);
+    }
+    if (app.got_subcommand("run") && worldSize > 1) {
+      // Several ranks would each run the whole scene into the same files: refused until the
+      // solvers run distributed (`mfsi partition` shows the decomposition they will use).
+      if (worldRank == 0)
+        std::cerr << "error: mfsi run does not run distributed yet (started on " << worldSize
+                  << " ranks): run it on one rank (threads: --threads); `mfsi partition SCENE -n " << worldSize
+                  << "` shows the decomposition\n";
+      code = 2;
+    } else if (app.got_subcommand("partition")) {
+      code = worldRank == 0 ? commandPartition(scene, sets, partitionRanks, partitionOut) : 0;
+    } else if (app.got_subcommand("run")) {
       code = commandRun(scene, sets, out, overwrite, restart);
     } else if (app.got_subcommand("plot")) {
       code = commandPlot(plotDir, plotOut);

@@ -301,8 +301,12 @@ HexMesh buildHexMesh(const HexMeshInput& in) {
   HexMesh m;
   m.source_ = src;
   m.nInternalFaces_ = nInternal;
-  m.nOwnedCells_ = nCells;
-  m.nOwnedNodes_ = nNodes;
+  MFSI_CHECK(in.cellGlobalIds.empty() || in.cellGlobalIds.size() == in.cells.size(),
+             src << ": " << in.cellGlobalIds.size() << " cell global ids for " << nCells << " cells");
+  MFSI_CHECK(in.nodeGlobalIds.empty() || in.nodeGlobalIds.size() == in.points.size(),
+             src << ": " << in.nodeGlobalIds.size() << " node global ids for " << nNodes << " nodes");
+  m.nOwnedCells_ = in.nOwnedCells >= 0 ? std::min(in.nOwnedCells, nCells) : nCells;
+  m.nOwnedNodes_ = in.nOwnedNodes >= 0 ? std::min(in.nOwnedNodes, nNodes) : nNodes;
   m.patches_ = patches;
   m.points_ = Real3View("mfsi::core::mesh::points", nNodes);
   m.points0_ = Real3View("mfsi::core::mesh::points0", nNodes);
@@ -344,12 +348,12 @@ HexMesh buildHexMesh(const HexMeshInput& in) {
   m.cellGid_ = GlobalIndexView("mfsi::core::mesh::cellGid", nCells);
   m.nodeGid_ = GlobalIndexView("mfsi::core::mesh::nodeGid", nNodes);
   {
-    auto cg = m.cellGid_;
-    auto ng = m.nodeGid_;
-    Kokkos::parallel_for("mfsi::core::mesh::identityCellGid", RangePolicy(0, nCells),
-                         KOKKOS_LAMBDA(lid_t c) { cg(c) = c; });
-    Kokkos::parallel_for("mfsi::core::mesh::identityNodeGid", RangePolicy(0, nNodes),
-                         KOKKOS_LAMBDA(lid_t n) { ng(n) = n; });
+    auto hc = Kokkos::create_mirror_view(m.cellGid_);
+    auto hn = Kokkos::create_mirror_view(m.nodeGid_);
+    for (lid_t c = 0; c < nCells; ++c) hc(c) = in.cellGlobalIds.empty() ? c : in.cellGlobalIds[c];
+    for (lid_t n = 0; n < nNodes; ++n) hn(n) = in.nodeGlobalIds.empty() ? n : in.nodeGlobalIds[n];
+    Kokkos::deep_copy(m.cellGid_, hc);
+    Kokkos::deep_copy(m.nodeGid_, hn);
   }
   return m;
 }

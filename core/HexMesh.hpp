@@ -73,6 +73,12 @@ struct HexMeshInput {
   std::vector<BaffleSpec> baffles;
   /// Name of the patch that collects boundary faces no patch claims. Empty: such faces are an error.
   std::string defaultPatch = "defaultFaces";
+  /// One rank's part of a decomposed mesh (core/parallel/LocalMesh): the global ids of its cells
+  /// and nodes (empty: 0, 1, 2, ...) and how many of each it owns (-1: all); owned ones come first.
+  std::vector<gid_t> cellGlobalIds;
+  std::vector<gid_t> nodeGlobalIds;
+  lid_t nOwnedCells = -1;
+  lid_t nOwnedNodes = -1;
 };
 
 /// \brief The mesh. Topology is fixed after construction; `points()` moves (ALE).

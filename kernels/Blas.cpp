@@ -2,6 +2,32 @@
 
 #include <cmath>
 #include <limits>
+#include <vector>
+
+namespace mfsi {
+
+SolverComm::SolverComm(MPI_Comm comm, const Halo* halo) : comm_(comm), halo_(halo) {
+  if (comm_ != MPI_COMM_NULL) MPI_Comm_size(comm_, &size_);
+}
+
+void SolverComm::gatherSum(double* values, int n) const {
+  // Every rank's partials, added in rank order: the same bits on every rank, every run.
+  std::vector<double> all(static_cast<std::size_t>(n) * size_);
+  MPI_Allgather(values, n, MPI_DOUBLE, all.data(), n, MPI_DOUBLE, comm_);
+  for (int i = 0; i < n; ++i) {
+    double s = 0;
+    for (int r = 0; r < size_; ++r) s += all[static_cast<std::size_t>(r) * n + i];
+    values[i] = s;
+  }
+}
+
+double SolverComm::reduceMax(double local) const {
+  double global = local;
+  MPI_Allreduce(&local, &global, 1, MPI_DOUBLE, MPI_MAX, comm_);
+  return global;
+}
+
+}  // namespace mfsi
 
 namespace mfsi::blas {
 

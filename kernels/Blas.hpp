@@ -12,7 +12,10 @@
 /// [nRows, nCols) of the vectors it multiplies. A distributed solve adds exactly two things,
 /// both behind `SolverComm`: `updateGhosts` before each SpMV and `globalSum` after each local
 /// reduction. On one rank both are no-ops.
+#include "core/parallel/Halo.hpp"
 #include "kernels/CsrMatrix.hpp"
+
+#include <mpi.h>
 
 #include <array>
 #include <cstddef>
@@ -22,15 +25,22 @@
 
 namespace mfsi {
 
-/// \brief The rank-decomposition hooks of the linear algebra. One rank: sums are local and there
-/// are no ghosts. An MPI version replaces the bodies by `MPI_Allreduce` (a single call for all
-/// values of a fused reduction) and a halo exchange; no solver code changes.
+/// \brief The rank-decomposition hooks of the linear algebra. One rank (the default): sums are
+/// local and there are no ghosts. Over an MPI communicator, sums gather every rank's partials and
+/// add them in rank order on every rank, so a reduction is bitwise the same on all ranks and from
+/// run to run at a given rank count (an MPI_Allreduce may pick its summation order by message
+/// size); ghost updates go through the cells' halo exchange (core/parallel/Halo).
 class SolverComm {
  public:
+  SolverComm() = default;
+  /// \brief Reductions over `comm`; ghost updates through `halo` (null: no ghosts). The halo must
+  /// outlive this object.
+  SolverComm(MPI_Comm comm, const Halo* halo);
+
+  int ranks() const { return size_; }
   /// \brief Sum `n` per-rank partial sums over all ranks, in place.
   void globalSum(double* values, int n) const {
-    (void)values;
-    (void)n;
+    if (size_ > 1) gatherSum(values, n);
   }
   /// \brief Sum one per-rank partial sum over all ranks.
   double globalSum(double local) const {
@@ -38,17 +48,23 @@ class SolverComm {
     return local;
   }
   /// \brief Maximum of a per-rank value over all ranks.
-  double globalMax(double local) const { return local; }
+  double globalMax(double local) const { return size_ > 1 ? reduceMax(local) : local; }
   /// \brief Refresh ghost entries [nRows, nCols) of `x` before it is multiplied by a matrix.
   void updateGhosts(const ExecSpace& exec, const RealView& x) const {
-    (void)exec;
-    (void)x;
+    if (halo_ != nullptr) halo_->exchange(exec, x);
   }
   /// \brief Same for the rows [nRows, nCols) of an n x 3 multi-vector (one exchange for all three).
   void updateGhosts(const ExecSpace& exec, const Real3View& x) const {
-    (void)exec;
-    (void)x;
+    if (halo_ != nullptr) halo_->exchange(exec, x);
   }
+
+ private:
+  void gatherSum(double* values, int n) const;
+  double reduceMax(double local) const;
+
+  MPI_Comm comm_ = MPI_COMM_NULL;
+  int size_ = 1;
+  const Halo* halo_ = nullptr;
 };
 
 namespace blas {

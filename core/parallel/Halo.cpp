@@ -1,0 +1,126 @@
+#include "core/parallel/Halo.hpp"
+
+#include "core/Error.hpp"
+
+namespace mfsi {
+
+namespace {
+constexpr int kHaloTag = 7411;
+static_assert(sizeof(real) == sizeof(double), "the halo sends reals as MPI_DOUBLE");
+}  // namespace
+
+Halo::Halo(MPI_Comm comm, const HaloPlan& plan)
+    : comm_(comm),
+      neighbours_(plan.neighbours),
+      sendOffsets_(plan.sendOffsets),
+      recvOffsets_(plan.recvOffsets),
+      nOwned_(plan.nOwned),
+      nLocal_(plan.nLocal) {
+  MFSI_CHECK(sendOffsets_.size() == neighbours_.size() + 1 && recvOffsets_.size() == neighbours_.size() + 1,
+             "halo: inconsistent plan (" << neighbours_.size() << " neighbours)");
+  MFSI_CHECK(nOwned_ + recvOffsets_.back() == nLocal_,
+             "halo: " << nOwned_ << " owned + " << recvOffsets_.back() << " ghosts != " << nLocal_ << " entries");
+  const lid_t nSend = sendOffsets_.back(), nRecv = recvOffsets_.back();
+  sendIndices_ = IndexView("mfsi::core::halo::sendIndices", nSend);
+  {
+    auto h = Kokkos::create_mirror_view(sendIndices_);
+    for (lid_t i = 0; i < nSend; ++i) h(i) = plan.sendIndices[i];
+    Kokkos::deep_copy(sendIndices_, h);
+  }
+  sendBuf_ = RealView("mfsi::core::halo::sendBuffer", 3 * static_cast<std::size_t>(nSend));
+  recvBuf_ = RealView("mfsi::core::halo::recvBuffer", 3 * static_cast<std::size_t>(nRecv));
+  sendHost_ = Kokkos::create_mirror_view(sendBuf_);
+  recvHost_ = Kokkos::create_mirror_view(recvBuf_);
+}
+
+Halo::~Halo() {
+  int finalized = 0;
+  MPI_Finalized(&finalized);
+  if (finalized) return;
+  for (auto& list : requests_)
+    for (auto& r : list)
+      if (r != MPI_REQUEST_NULL) MPI_Request_free(&r);
+}
+
+std::int64_t Halo::sendBytes(int components) const {
+  return static_cast<std::int64_t>(sendOffsets_.empty() ? 0 : sendOffsets_.back()) * components *
+         static_cast<std::int64_t>(sizeof(real));
+}
+
+int Halo::sendMessages() const {
+  int n = 0;
+  for (std::size_t k = 0; k < neighbours_.size(); ++k) n += sendOffsets_[k + 1] > sendOffsets_[k] ? 1 : 0;
+  return n;
+}
+
+void Halo::start(int components) const {
+  auto& reqs = requests_[components == 1 ? 0 : 1];
+  if (reqs.empty()) {
+    // Persistent requests on the (fixed) host buffers; a column count picks the message length.
+    for (std::size_t k = 0; k < neighbours_.size(); ++k) {
+      const int nr = (recvOffsets_[k + 1] - recvOffsets_[k]) * components;
+      const int ns = (sendOffsets_[k + 1] - sendOffsets_[k]) * components;
+      MPI_Request r;
+      if (nr > 0) {
+        MPI_Recv_init(recvHost_.data() + recvOffsets_[k] * components, nr, MPI_DOUBLE, neighbours_[k], kHaloTag,
+                      comm_, &r);
+        reqs.push_back(r);
+      }
+      if (ns > 0) {
+        MPI_Send_init(sendHost_.data() + sendOffsets_[k] * components, ns, MPI_DOUBLE, neighbours_[k], kHaloTag,
+                      comm_, &r);
+        reqs.push_back(r);
+      }
+    }
+  }
+  if (!reqs.empty()) MPI_Startall(static_cast<int>(reqs.size()), reqs.data());
+}
+
+void Halo::finish(int components) const {
+  auto& reqs = requests_[components == 1 ? 0 : 1];
+  if (!reqs.empty()) MPI_Waitall(static_cast<int>(reqs.size()), reqs.data(), MPI_STATUSES_IGNORE);
+}
+
+void Halo::exchange(const ExecSpace& exec, const RealView& x) const {
+  if (neighbours_.empty()) return;
+  MFSI_CHECK(static_cast<lid_t>(x.extent(0)) >= nLocal_,
+             "halo: field '" << x.label() << "' has " << x.extent(0) << " entries, the halo " << nLocal_);
+  const lid_t nSend = sendOffsets_.back(), nRecv = recvOffsets_.back(), base = nOwned_;
+  auto idx = sendIndices_;
+  auto buf = sendBuf_;
+  Kokkos::parallel_for("mfsi::core::halo::pack1", RangePolicy(exec, 0, nSend),
+                       KOKKOS_LAMBDA(lid_t i) { buf(i) = x(idx(i)); });
+  Kokkos::deep_copy(exec, sendHost_, sendBuf_);
+  exec.fence();
+  start(1);
+  finish(1);
+  Kokkos::deep_copy(exec, recvBuf_, recvHost_);
+  auto rb = recvBuf_;
+  Kokkos::parallel_for("mfsi::core::halo::unpack1", RangePolicy(exec, 0, nRecv),
+                       KOKKOS_LAMBDA(lid_t i) { x(base + i) = rb(i); });
+}
+
+void Halo::exchange(const ExecSpace& exec, const Real3View& x) const {
+  if (neighbours_.empty()) return;
+  MFSI_CHECK(static_cast<lid_t>(x.extent(0)) >= nLocal_,
+             "halo: field '" << x.label() << "' has " << x.extent(0) << " entries, the halo " << nLocal_);
+  const lid_t nSend = sendOffsets_.back(), nRecv = recvOffsets_.back(), base = nOwned_;
+  auto idx = sendIndices_;
+  auto buf = sendBuf_;
+  Kokkos::parallel_for(
+      "mfsi::core::halo::pack3", RangePolicy(exec, 0, nSend), KOKKOS_LAMBDA(lid_t i) {
+        for (int k = 0; k < 3; ++k) buf(3 * i + k) = x(idx(i), k);
+      });
+  Kokkos::deep_copy(exec, sendHost_, sendBuf_);
+  exec.fence();
+  start(3);
+  finish(3);
+  Kokkos::deep_copy(exec, recvBuf_, recvHost_);
+  auto rb = recvBuf_;
+  Kokkos::parallel_for(
+      "mfsi::core::halo::unpack3", RangePolicy(exec, 0, nRecv), KOKKOS_LAMBDA(lid_t i) {
+        for (int k = 0; k < 3; ++k) x(base + i, k) = rb(3 * i + k);
+      });
+}
+
+}  // namespace mfsi

@@ -1,0 +1,58 @@
+#pragma once
+/// \file
+/// \brief Halo exchange: the owners' values copied into the ghosts of every neighbour rank.
+///
+/// Pack and unpack are Kokkos kernels over one contiguous buffer per direction; the messages are
+/// persistent MPI requests (created at the first exchange, reused after), staged through host
+/// mirrors of the buffers (a no-op on host memory spaces; a device build copies, which a
+/// device-aware MPI would spare). Received values land in the ghost ranges directly from the
+/// buffer, since ghosts are grouped by owner (core/parallel/LocalMesh). An exchange is
+/// deterministic: each value is a copy, never a sum.
+#include "core/Types.hpp"
+#include "core/parallel/LocalMesh.hpp"
+
+#include <mpi.h>
+
+#include <cstdint>
+#include <vector>
+
+namespace mfsi {
+
+/// \brief One kind of entity's halo on one rank. Not copyable (it owns MPI requests).
+class Halo {
+ public:
+  /// No neighbours: exchanges do nothing.
+  Halo() = default;
+  Halo(MPI_Comm comm, const HaloPlan& plan);
+  ~Halo();
+  Halo(const Halo&) = delete;
+  Halo& operator=(const Halo&) = delete;
+
+  /// \brief Ghost entries [nOwned, nLocal) of `x` <- their owners' values.
+  void exchange(const ExecSpace& exec, const RealView& x) const;
+  /// \brief The same for the three columns of an n x 3 field, in one message per neighbour.
+  void exchange(const ExecSpace& exec, const Real3View& x) const;
+
+  int neighbours() const { return static_cast<int>(neighbours_.size()); }
+  lid_t nOwned() const { return nOwned_; }
+  lid_t nLocal() const { return nLocal_; }
+  /// \brief Values sent by this rank per exchange of `components` columns, in bytes.
+  std::int64_t sendBytes(int components) const;
+  /// \brief Messages sent by this rank per exchange (empty ones are not sent).
+  int sendMessages() const;
+
+ private:
+  void start(int components) const;
+  void finish(int components) const;
+
+  MPI_Comm comm_ = MPI_COMM_NULL;
+  std::vector<int> neighbours_;
+  std::vector<lid_t> sendOffsets_, recvOffsets_;
+  IndexView sendIndices_;
+  lid_t nOwned_ = 0, nLocal_ = 0;
+  RealView sendBuf_, recvBuf_;
+  RealView::HostMirror sendHost_, recvHost_;
+  mutable std::vector<MPI_Request> requests_[2];  ///< persistent: [0] one column, [1] three
+};
+
+}  // namespace mfsi

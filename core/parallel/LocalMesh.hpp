@@ -1,0 +1,48 @@
+#pragma once
+/// \file
+/// \brief One rank's part of a decomposed mesh: its owned cells, a layer (or more) of ghost cells
+/// around them, the nodes of both, and the halo plans that say which owned entries each
+/// neighbour rank needs and where the ghosts' values arrive.
+///
+/// Ordering (what the halo exchange relies on): owned cells first, in global-id order, then the
+/// ghosts grouped by their owner rank (ascending) and in global-id order within a group, so the
+/// values from one neighbour land in one contiguous range. Nodes likewise: a node belongs to the
+/// lowest rank whose owned cells use it. A ghost cell's face that leads out of the rank's cells
+/// goes to the patch "processor". Every rank computes every rank's ghost lists from the same
+/// global mesh and partition (no communication); that is O(global mesh) per rank, which suits the
+/// start-up of today's runs and is what a parallel mesh reader will replace.
+#include "core/HexMesh.hpp"
+
+#include <string>
+#include <vector>
+
+namespace mfsi {
+
+/// Name of the patch that collects a part's faces leading to cells of other ranks.
+inline constexpr const char* kProcessorPatch = "processor";
+
+/// \brief Who sends what to whom, for one kind of entity (cells or nodes) on one rank.
+struct HaloPlan {
+  std::vector<int> neighbours;      ///< ranks exchanged with, ascending
+  std::vector<lid_t> sendOffsets;   ///< per neighbour, into sendIndices (size neighbours + 1)
+  std::vector<lid_t> sendIndices;   ///< local indices of owned entries, in the receiver's order
+  std::vector<lid_t> recvOffsets;   ///< per neighbour: ghost range [nOwned + recvOffsets[k], nOwned + recvOffsets[k+1])
+  lid_t nOwned = 0;
+  lid_t nLocal = 0;                 ///< owned + ghosts
+};
+
+/// \brief One rank's mesh and its two halo plans.
+struct LocalMeshPart {
+  int rank = 0;
+  int ranks = 1;
+  HexMeshInput input;   ///< to build the rank's HexMesh (global ids and owned counts filled)
+  HaloPlan cells;
+  HaloPlan nodes;
+};
+
+/// \brief The part of `global` that `rank` holds under `cellRank` (one entry per global cell),
+/// with `ghostLayers` layers of face-neighbour ghost cells (>= 1).
+LocalMeshPart localMeshPart(const HexMesh& global, const std::vector<int>& cellRank, int ranks, int rank,
+                            int ghostLayers = 1);
+
+}  // namespace mfsi
