@@ -1,0 +1,525 @@
+#include "kernels/DistributedAmg.hpp"
+
+#include "core/Error.hpp"
+#include "core/parallel/Halo.hpp"
+#include "core/parallel/RowExchange.hpp"
+
+#include <Eigen/Dense>
+
+#include <algorithm>
+#include <cmath>
+#include <map>
+#include <string>
+
+namespace mfsi {
+
+namespace {
+
+using HostSpace = Kokkos::HostSpace;
+using Row = std::vector<std::pair<gid_t, double>>;
+
+/// Host CSR of one level: owned rows, local column indices (owned, then ghosts).
+struct HostCsr {
+  lid_t nRows = 0, nCols = 0;
+  std::vector<lid_t> ptr{0}, col;
+  std::vector<double> val;
+};
+
+template <class T>
+Kokkos::View<T*, MemSpace> deviceCopy(const std::vector<T>& v, const std::string& label) {
+  Kokkos::View<T*, MemSpace> d(label, v.size());
+  auto h = Kokkos::create_mirror_view(d);
+  for (std::size_t i = 0; i < v.size(); ++i) h(i) = v[i];
+  Kokkos::deep_copy(d, h);
+  return d;
+}
+
+CsrMatrix toDevice(const HostCsr& h, const std::string& label) {
+  CsrMatrix M;
+  M.nRows = h.nRows;
+  M.nCols = h.nCols;
+  M.rowPtr = deviceCopy(h.ptr, label + "::rowPtr");
+  M.colIdx = deviceCopy(h.col, label + "::colIdx");
+  M.values = deviceCopy(h.val, label + "::values");
+  std::vector<lid_t> diag(h.nRows, -1);
+  for (lid_t i = 0; i < h.nRows; ++i)
+    for (lid_t p = h.ptr[i]; p < h.ptr[i + 1]; ++p)
+      if (h.col[p] == i) diag[i] = p;
+  M.diagIdx = deviceCopy(diag, label + "::diagIdx");
+  return M;
+}
+
+HostCsr hostCopy(const CsrMatrix& A) {
+  HostCsr h;
+  h.nRows = A.nRows;
+  h.nCols = A.nCols;
+  auto ptr = Kokkos::create_mirror_view_and_copy(HostSpace(), A.rowPtr);
+  auto col = Kokkos::create_mirror_view_and_copy(HostSpace(), A.colIdx);
+  auto val = Kokkos::create_mirror_view_and_copy(HostSpace(), A.values);
+  h.ptr.assign(ptr.data(), ptr.data() + A.nRows + 1);
+  h.col.assign(col.data(), col.data() + h.ptr.back());
+  h.val.assign(val.data(), val.data() + h.ptr.back());
+  return h;
+}
+
+/// Greedy three-phase aggregation of the owned rows over their owned strong couplings
+/// (|a_ij| >= theta sqrt(|a_ii a_jj|); theta = 0: every nonzero coupling). Every row gets an
+/// aggregate (an isolated row is one of its own).
+std::vector<lid_t> aggregateOwned(const HostCsr& A, double theta, lid_t& nAgg) {
+  const lid_t n = A.nRows;
+  std::vector<double> d(n, 0.0);
+  for (lid_t i = 0; i < n; ++i)
+    for (lid_t p = A.ptr[i]; p < A.ptr[i + 1]; ++p)
+      if (A.col[p] == i) d[i] = A.val[p];
+  auto strong = [&](lid_t i, lid_t p) {
+    const lid_t j = A.col[p];
+    if (j == i || j >= n || A.val[p] == 0) return false;
+    return std::abs(A.val[p]) >= theta * std::sqrt(std::abs(d[i] * d[j]));
+  };
+  std::vector<lid_t> agg(n, -1);
+  nAgg = 0;
+  for (lid_t i = 0; i < n; ++i) {  // roots whose strong neighbours are all free
+    if (agg[i] >= 0) continue;
+    bool free = true, any = false;
+    for (lid_t p = A.ptr[i]; p < A.ptr[i + 1]; ++p)
+      if (strong(i, p)) {
+        any = true;
+        free = free && agg[A.col[p]] < 0;
+      }
+    if (!any || !free) continue;
+    agg[i] = nAgg;
+    for (lid_t p = A.ptr[i]; p < A.ptr[i + 1]; ++p)
+      if (strong(i, p)) agg[A.col[p]] = nAgg;
+    ++nAgg;
+  }
+  const std::vector<lid_t> first = agg;
+  for (lid_t i = 0; i < n; ++i) {  // leftovers join their strongest aggregated neighbour
+    if (agg[i] >= 0) continue;
+    double best = -1;
+    for (lid_t p = A.ptr[i]; p < A.ptr[i + 1]; ++p)
+      if (strong(i, p) && first[A.col[p]] >= 0 && std::abs(A.val[p]) > best) {
+        best = std::abs(A.val[p]);
+        agg[i] = first[A.col[p]];
+      }
+  }
+  for (lid_t i = 0; i < n; ++i) {  // the rest: new aggregates with their free strong neighbours
+    if (agg[i] >= 0) continue;
+    agg[i] = nAgg;
+    for (lid_t p = A.ptr[i]; p < A.ptr[i + 1]; ++p)
+      if (strong(i, p) && agg[A.col[p]] < 0) agg[A.col[p]] = nAgg;
+    ++nAgg;
+  }
+  return agg;
+}
+
+/// d = c * inv .* r on the first n entries.
+void scaled(const ExecSpace& exec, lid_t n, double c, const RealView& inv, const RealView& r, const RealView& d) {
+  Kokkos::parallel_for(
+      "mfsi::kernels::damg::scaled", RangePolicy(exec, 0, n), KOKKOS_LAMBDA(lid_t i) { d(i) = c * inv(i) * r(i); });
+}
+
+/// d = a d + c inv .* r on the first n entries.
+void chebyshevDirection(const ExecSpace& exec, lid_t n, double a, double c, const RealView& inv, const RealView& r,
+                        const RealView& d) {
+  Kokkos::parallel_for(
+      "mfsi::kernels::damg::direction", RangePolicy(exec, 0, n),
+      KOKKOS_LAMBDA(lid_t i) { d(i) = a * d(i) + c * inv(i) * r(i); });
+}
+
+/// r = b - r on the first n entries.
+void fromProduct(const ExecSpace& exec, lid_t n, const RealView& b, const RealView& r) {
+  Kokkos::parallel_for(
+      "mfsi::kernels::damg::residual", RangePolicy(exec, 0, n), KOKKOS_LAMBDA(lid_t i) { r(i) = b(i) - r(i); });
+}
+
+/// x(i) = sum_k inv(i, k) b(k): the gathered coarsest solve of the owned rows, in a fixed order.
+void denseRows(const ExecSpace& exec, const Kokkos::View<double**, MemSpace>& inv, const RealView& b,
+               const RealView& x) {
+  const lid_t n = static_cast<lid_t>(inv.extent(0)), m = static_cast<lid_t>(inv.extent(1));
+  Kokkos::parallel_for(
+      "mfsi::kernels::damg::coarsest", RangePolicy(exec, 0, n), KOKKOS_LAMBDA(lid_t i) {
+        double s = 0;
+        for (lid_t k = 0; k < m; ++k) s += inv(i, k) * b(k);
+        x(i) = s;
+      });
+}
+
+}  // namespace
+
+struct DistributedAmg::Impl {
+  struct Level {
+    HostCsr hA;
+    std::vector<gid_t> gid;  ///< local -> global
+    HaloPlan plan;
+    std::unique_ptr<Halo> halo;
+    CsrMatrix A, P, R;
+    RealView invDiag, x, b, r, d;
+    double lambdaMax = 1;
+  };
+
+  MPI_Comm comm = MPI_COMM_NULL;  ///< null on one rank
+  int ranks = 1, me = 0;
+  DistributedAmgOptions opt;
+  HaloPlan finePlan;
+  std::vector<gid_t> fineIds;
+  std::vector<Level> levels;
+  std::vector<DistributedAmgLevelInfo> info;
+  // Coarsest level, gathered on every rank.
+  Kokkos::View<double**, MemSpace> coarseInv;  ///< owned rows x all rows (gathered order)
+  RealView coarseAll;
+  std::vector<int> coarseCounts, coarseDispls;
+
+  SolverComm solverComm(const Level& L) const { return SolverComm(comm, L.halo.get()); }
+
+  std::int64_t globalCount(std::int64_t local) const {
+    if (ranks == 1) return local;
+    std::int64_t g = 0;
+    MPI_Allreduce(&local, &g, 1, MPI_INT64_T, MPI_SUM, comm);
+    return g;
+  }
+
+  void finishLevel(const ExecSpace& exec, Level& L, std::size_t l) {
+    const std::string label = "mfsi::kernels::damg::level" + std::to_string(l);
+    L.A = toDevice(L.hA, label + "::A");
+    L.halo = std::make_unique<Halo>(comm, L.plan);
+    L.invDiag = RealView(label + "::invDiag", L.hA.nRows);
+    invertDiagonal(exec, L.A, L.invDiag);
+    for (RealView* v : {&L.x, &L.b, &L.r, &L.d}) *v = RealView(label + "::work", L.hA.nCols);
+    // lambda_max(D^-1 A) by power iterations from a start vector fixed by the global ids.
+    const SolverComm sc = solverComm(L);
+    {
+      auto h = Kokkos::create_mirror_view(L.x);
+      for (lid_t i = 0; i < L.hA.nRows; ++i) h(i) = 1.0 + 0.5 * std::sin(0.7 * static_cast<double>(L.gid[i]));
+      Kokkos::deep_copy(L.x, h);
+    }
+    double lambda = 1;
+    for (int it = 0; it < 20; ++it) {
+      L.halo->exchange(exec, L.x);
+      blas::spmv(exec, L.A, L.x, L.r);
+      scaled(exec, L.hA.nRows, 1.0, L.invDiag, L.r, L.r);
+      const double nx = blas::norm2(exec, sc, L.hA.nRows, L.x), nr = blas::norm2(exec, sc, L.hA.nRows, L.r);
+      if (!(nr > 0)) break;
+      lambda = nr / nx;
+      Kokkos::deep_copy(exec, L.x, L.r);  // x = D^-1 A x / |D^-1 A x|
+      blas::axpby(exec, L.hA.nRows, 0.0, L.r, 1.0 / nr, L.x);
+    }
+    L.lambdaMax = 1.1 * lambda;
+    DistributedAmgLevelInfo li;
+    li.rows = globalCount(L.hA.nRows);
+    li.nonzeros = globalCount(L.hA.ptr.back());
+    li.ownedRows = L.hA.nRows;
+    li.ghosts = L.hA.nCols - L.hA.nRows;
+    info.push_back(li);
+  }
+
+  /// The next level of `L` (aggregation, P, R, A_c, its halo); false when L is the coarsest.
+  bool coarsen(const ExecSpace& exec, std::size_t l) {
+    Level& L = levels[l];
+    const lid_t nOwned = L.hA.nRows, nLocal = L.hA.nCols;
+    lid_t nAgg = 0;
+    const std::vector<lid_t> agg = aggregateOwned(L.hA, l == 0 ? opt.strengthThreshold : 0.0, nAgg);
+    const std::int64_t rows = info[l].rows, coarseRows = globalCount(nAgg);
+    if (coarseRows >= rows) return false;  // no coarsening: solve this level directly
+
+    // Global ids of the aggregates: contiguous per rank.
+    std::vector<gid_t> start(ranks + 1, 0);
+    {
+      std::vector<long long> counts(ranks, nAgg);
+      long long mine = nAgg;
+      if (ranks > 1) MPI_Allgather(&mine, 1, MPI_LONG_LONG, counts.data(), 1, MPI_LONG_LONG, comm);
+      for (int r = 0; r < ranks; ++r) start[r + 1] = start[r] + counts[r];
+    }
+    const gid_t first = start[me], last = start[me + 1];
+    // The aggregate of every local fine entry (ghosts: from their owners).
+    std::vector<gid_t> cg(nLocal);
+    {
+      auto h = Kokkos::create_mirror_view(L.r);
+      for (lid_t i = 0; i < nOwned; ++i) h(i) = static_cast<double>(first + agg[i]);
+      Kokkos::deep_copy(L.r, h);
+      L.halo->exchange(exec, L.r);
+      Kokkos::deep_copy(h, L.r);
+      for (lid_t i = 0; i < nLocal; ++i) cg[i] = static_cast<gid_t>(std::llround(h(i)));
+    }
+    // Smoothed prolongator rows P = (I - omega D^-1 A) P_tent of the owned entries, then the
+    // ghosts' rows from their owners.
+    const double omega = opt.prolongationDamping / L.lambdaMax;
+    GlobalRows pOwned;
+    for (lid_t i = 0; i < nOwned; ++i) {
+      std::map<gid_t, double> row;
+      double di = 0;
+      for (lid_t p = L.hA.ptr[i]; p < L.hA.ptr[i + 1]; ++p)
+        if (L.hA.col[p] == i) di = L.hA.val[p];
+      row[cg[i]] += 1.0;
+      for (lid_t p = L.hA.ptr[i]; p < L.hA.ptr[i + 1]; ++p) row[cg[L.hA.col[p]]] -= omega * L.hA.val[p] / di;
+      pOwned.push(Row(row.begin(), row.end()));
+    }
+    const GlobalRows pGhost = exchangeRows(comm, L.plan, pOwned);
+    auto pRow = [&](lid_t j, auto&& f) {
+      const GlobalRows& src = j < nOwned ? pOwned : pGhost;
+      const lid_t k = j < nOwned ? j : j - nOwned;
+      for (lid_t p = src.ptr[k]; p < src.ptr[k + 1]; ++p) f(src.col[p], src.val[p]);
+    };
+    // A P on the owned rows, then on the ghosts.
+    GlobalRows bOwned;
+    for (lid_t i = 0; i < nOwned; ++i) {
+      std::map<gid_t, double> row;
+      for (lid_t p = L.hA.ptr[i]; p < L.hA.ptr[i + 1]; ++p) {
+        const double a = L.hA.val[p];
+        pRow(L.hA.col[p], [&](gid_t c, double v) { row[c] += a * v; });
+      }
+      bOwned.push(Row(row.begin(), row.end()));
+    }
+    const GlobalRows bGhost = exchangeRows(comm, L.plan, bOwned);
+    // R = P^T on the owned aggregates: every local fine entry's prolongator row that reaches one.
+    std::vector<std::vector<std::pair<lid_t, double>>> rRows(nAgg);
+    for (lid_t j = 0; j < nLocal; ++j)
+      pRow(j, [&](gid_t c, double v) {
+        if (c >= first && c < last) rRows[c - first].emplace_back(j, v);
+      });
+    // A_c = R (A P), rows of the owned aggregates, in a fixed order of summation.
+    std::vector<std::map<gid_t, double>> acRows(nAgg);
+    for (lid_t a = 0; a < nAgg; ++a)
+      for (const auto& [j, rv] : rRows[a]) {
+        const GlobalRows& src = j < nOwned ? bOwned : bGhost;
+        const lid_t k = j < nOwned ? j : j - nOwned;
+        for (lid_t p = src.ptr[k]; p < src.ptr[k + 1]; ++p) acRows[a][src.col[p]] += rv * src.val[p];
+      }
+    // Coarse ghosts: the other ranks' aggregates that A_c and P touch (their ids grow with their
+    // owner, so sorting by id sorts by owner too).
+    std::vector<gid_t> ghosts;
+    for (const auto& row : acRows)
+      for (const auto& [c, v] : row)
+        if (c < first || c >= last) ghosts.push_back(c);
+    for (gid_t c : pOwned.col)
+      if (c < first || c >= last) ghosts.push_back(c);
+    std::sort(ghosts.begin(), ghosts.end());
+    ghosts.erase(std::unique(ghosts.begin(), ghosts.end()), ghosts.end());
+    std::vector<int> owner(ghosts.size());
+    for (std::size_t g = 0; g < ghosts.size(); ++g)
+      owner[g] = static_cast<int>(std::upper_bound(start.begin(), start.end(), ghosts[g]) - start.begin()) - 1;
+    auto localOf = [&](gid_t c) -> lid_t {
+      if (c >= first && c < last) return static_cast<lid_t>(c - first);
+      return nAgg + static_cast<lid_t>(std::lower_bound(ghosts.begin(), ghosts.end(), c) - ghosts.begin());
+    };
+    const lid_t nCoarseLocal = nAgg + static_cast<lid_t>(ghosts.size());
+
+    // Device P (owned fine rows x local coarse columns) and R (owned aggregates x local fine).
+    HostCsr hP, hR, hAc;
+    hP.nRows = nOwned;
+    hP.nCols = nCoarseLocal;
+    for (lid_t i = 0; i < nOwned; ++i) {
+      std::vector<std::pair<lid_t, double>> row;
+      pRow(i, [&](gid_t c, double v) { row.emplace_back(localOf(c), v); });
+      std::sort(row.begin(), row.end());
+      for (const auto& [c, v] : row) {
+        hP.col.push_back(c);
+        hP.val.push_back(v);
+      }
+      hP.ptr.push_back(static_cast<lid_t>(hP.col.size()));
+    }
+    hR.nRows = nAgg;
+    hR.nCols = nLocal;
+    hAc.nRows = nAgg;
+    hAc.nCols = nCoarseLocal;
+    for (lid_t a = 0; a < nAgg; ++a) {
+      for (const auto& [j, v] : rRows[a]) {
+        hR.col.push_back(j);
+        hR.val.push_back(v);
+      }
+      hR.ptr.push_back(static_cast<lid_t>(hR.col.size()));
+      std::vector<std::pair<lid_t, double>> row;
+      for (const auto& [c, v] : acRows[a]) row.emplace_back(localOf(c), v);
+      std::sort(row.begin(), row.end());
+      for (const auto& [c, v] : row) {
+        hAc.col.push_back(c);
+        hAc.val.push_back(v);
+      }
+      hAc.ptr.push_back(static_cast<lid_t>(hAc.col.size()));
+    }
+    const std::string label = "mfsi::kernels::damg::level" + std::to_string(l);
+    L.P = toDevice(hP, label + "::P");
+    L.R = toDevice(hR, label + "::R");
+
+    Level C;
+    C.hA = std::move(hAc);
+    C.gid.resize(nCoarseLocal);
+    for (lid_t a = 0; a < nAgg; ++a) C.gid[a] = first + a;
+    for (std::size_t g = 0; g < ghosts.size(); ++g) C.gid[nAgg + g] = ghosts[g];
+    C.plan = planFromGhosts(comm, first, nAgg, ghosts, owner);
+    levels.push_back(std::move(C));
+    finishLevel(exec, levels.back(), l + 1);
+    return true;
+  }
+
+  /// Gather the last level onto every rank and invert it (pseudo-inverse: a singular Neumann
+  /// operator keeps its null space out of the correction).
+  void gatherCoarsest(const ExecSpace& exec) {
+    const Level& L = levels.back();
+    const lid_t n = L.hA.nRows;
+    std::vector<long long> rowIds(L.gid.begin(), L.gid.begin() + n), colIds, allRows;
+    std::vector<int> rowLen(n);
+    std::vector<double> vals = L.hA.val;
+    for (lid_t i = 0; i < n; ++i) rowLen[i] = L.hA.ptr[i + 1] - L.hA.ptr[i];
+    for (lid_t c : L.hA.col) colIds.push_back(L.gid[c]);
+    coarseCounts.assign(ranks, n);
+    if (ranks > 1) MPI_Allgather(&n, 1, MPI_INT, coarseCounts.data(), 1, MPI_INT, comm);
+    coarseDispls.assign(ranks + 1, 0);
+    for (int r = 0; r < ranks; ++r) coarseDispls[r + 1] = coarseDispls[r] + coarseCounts[r];
+    const int total = coarseDispls[ranks];
+    allRows.resize(total);
+    std::vector<int> allLen(total);
+    if (ranks > 1) {
+      MPI_Allgatherv(rowIds.data(), n, MPI_LONG_LONG, allRows.data(), coarseCounts.data(), coarseDispls.data(),
+                     MPI_LONG_LONG, comm);
+      MPI_Allgatherv(rowLen.data(), n, MPI_INT, allLen.data(), coarseCounts.data(), coarseDispls.data(), MPI_INT, comm);
+    } else {
+      allRows = rowIds;
+      allLen = rowLen;
+    }
+    std::vector<int> nnzCounts(ranks, 0), nnzDispls(ranks + 1, 0);
+    for (int r = 0; r < ranks; ++r) {
+      for (int k = coarseDispls[r]; k < coarseDispls[r + 1]; ++k) nnzCounts[r] += allLen[k];
+      nnzDispls[r + 1] = nnzDispls[r] + nnzCounts[r];
+    }
+    std::vector<long long> allCols(nnzDispls[ranks]);
+    std::vector<double> allVals(nnzDispls[ranks]);
+    if (ranks > 1) {
+      MPI_Allgatherv(colIds.data(), static_cast<int>(colIds.size()), MPI_LONG_LONG, allCols.data(), nnzCounts.data(),
+                     nnzDispls.data(), MPI_LONG_LONG, comm);
+      MPI_Allgatherv(vals.data(), static_cast<int>(vals.size()), MPI_DOUBLE, allVals.data(), nnzCounts.data(),
+                     nnzDispls.data(), MPI_DOUBLE, comm);
+    } else {
+      allCols = colIds;
+      allVals = vals;
+    }
+    // Dense matrix in gathered order (rank by rank, each rank's rows in its order).
+    std::map<long long, int> where;
+    for (int k = 0; k < total; ++k) where[allRows[k]] = k;
+    Eigen::MatrixXd M = Eigen::MatrixXd::Zero(total, total);
+    for (int k = 0, p = 0; k < total; ++k)
+      for (int e = 0; e < allLen[k]; ++e, ++p) {
+        const auto it = where.find(allCols[p]);
+        MFSI_CHECK(it != where.end(), "distributed AMG: coarsest column " << allCols[p] << " has no row");
+        M(k, it->second) += allVals[p];
+      }
+    const Eigen::MatrixXd S = 0.5 * (M + M.transpose());
+    Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eig(S);
+    const Eigen::VectorXd lam = eig.eigenvalues();
+    const double cut = 1e-10 * lam.cwiseAbs().maxCoeff();
+    Eigen::VectorXd inv(total);
+    for (int k = 0; k < total; ++k) inv(k) = std::abs(lam(k)) > cut ? 1.0 / lam(k) : 0.0;
+    const Eigen::MatrixXd Pinv = eig.eigenvectors() * inv.asDiagonal() * eig.eigenvectors().transpose();
+    coarseInv = Kokkos::View<double**, MemSpace>("mfsi::kernels::damg::coarseInverse", n, total);
+    auto h = Kokkos::create_mirror_view(coarseInv);
+    for (lid_t i = 0; i < n; ++i)
+      for (int k = 0; k < total; ++k) h(i, k) = Pinv(coarseDispls[me] + i, k);
+    Kokkos::deep_copy(coarseInv, h);
+    coarseAll = RealView("mfsi::kernels::damg::coarseAll", total);
+    (void)exec;
+  }
+
+  void coarseSolve(const ExecSpace& exec, Level& L) {
+    const lid_t n = L.hA.nRows;
+    if (ranks == 1) {
+      Kokkos::deep_copy(exec, Kokkos::subview(coarseAll, std::make_pair(0, n)), Kokkos::subview(L.b, std::make_pair(0, n)));
+    } else {
+      auto hb = Kokkos::create_mirror_view_and_copy(HostSpace(), Kokkos::subview(L.b, std::make_pair(0, n)));
+      auto ha = Kokkos::create_mirror_view(coarseAll);
+      MPI_Allgatherv(hb.data(), n, MPI_DOUBLE, ha.data(), coarseCounts.data(), coarseDispls.data(), MPI_DOUBLE, comm);
+      Kokkos::deep_copy(exec, coarseAll, ha);
+    }
+    denseRows(exec, coarseInv, coarseAll, L.x);
+  }
+
+  void chebyshev(const ExecSpace& exec, Level& L) {
+    const lid_t n = L.hA.nRows;
+    const double upper = L.lambdaMax, lower = upper / opt.chebyshevRatio;
+    const double theta = 0.5 * (upper + lower), delta = 0.5 * (upper - lower), sigma = theta / delta;
+    L.halo->exchange(exec, L.x);
+    blas::spmv(exec, L.A, L.x, L.r);
+    fromProduct(exec, n, L.b, L.r);
+    scaled(exec, n, 1.0 / theta, L.invDiag, L.r, L.d);
+    double rhoOld = 1.0 / sigma;
+    for (int k = 1; k <= opt.chebyshevDegree; ++k) {
+      blas::axpy(exec, n, 1.0, L.d, L.x);
+      if (k == opt.chebyshevDegree) break;
+      L.halo->exchange(exec, L.d);
+      blas::spmv(exec, -1.0, L.A, L.d, 1.0, L.r);
+      const double rho = 1.0 / (2.0 * sigma - rhoOld);
+      chebyshevDirection(exec, n, rho * rhoOld, 2.0 * rho / delta, L.invDiag, L.r, L.d);
+      rhoOld = rho;
+    }
+  }
+
+  void cycle(const ExecSpace& exec, std::size_t l) {
+    Level& L = levels[l];
+    if (l + 1 == levels.size()) {
+      coarseSolve(exec, L);
+      return;
+    }
+    const lid_t n = L.hA.nRows;
+    blas::fill(exec, L.hA.nCols, 0.0, L.x);
+    chebyshev(exec, L);
+    L.halo->exchange(exec, L.x);
+    blas::spmv(exec, L.A, L.x, L.r);
+    fromProduct(exec, n, L.b, L.r);
+    L.halo->exchange(exec, L.r);
+    Level& C = levels[l + 1];
+    blas::spmv(exec, L.R, L.r, C.b);
+    cycle(exec, l + 1);
+    C.halo->exchange(exec, C.x);
+    blas::spmv(exec, 1.0, L.P, C.x, 1.0, L.x);
+    chebyshev(exec, L);
+  }
+};
+
+DistributedAmg::DistributedAmg(MPI_Comm comm, const HaloPlan& plan, std::vector<gid_t> globalIds,
+                               const DistributedAmgOptions& options)
+    : impl_(std::make_unique<Impl>()) {
+  impl_->ranks = commSize(comm);
+  impl_->me = commRank(comm);
+  impl_->comm = impl_->ranks > 1 ? comm : MPI_COMM_NULL;
+  impl_->opt = options;
+  impl_->finePlan = plan;
+  impl_->fineIds = std::move(globalIds);
+  MFSI_CHECK(static_cast<lid_t>(impl_->fineIds.size()) == plan.nLocal,
+             "distributed AMG: " << impl_->fineIds.size() << " global ids for " << plan.nLocal << " columns");
+  MFSI_CHECK(options.chebyshevDegree >= 1 && options.coarseSize >= 1 && options.maxLevels >= 1,
+             "distributed AMG: chebyshevDegree, coarseSize and maxLevels must be >= 1");
+}
+
+DistributedAmg::~DistributedAmg() = default;
+
+const std::vector<DistributedAmgLevelInfo>& DistributedAmg::levels() const { return impl_->info; }
+
+void DistributedAmg::setup(const ExecSpace& exec, const CsrMatrix& A) {
+  Impl& m = *impl_;
+  MFSI_CHECK(A.nRows == m.finePlan.nOwned && A.nCols == m.finePlan.nLocal,
+             "distributed AMG: a " << A.nRows << " x " << A.nCols << " matrix for a halo of " << m.finePlan.nOwned
+                                   << " owned and " << m.finePlan.nLocal << " local entries");
+  m.levels.clear();
+  m.info.clear();
+  Impl::Level L0;
+  L0.hA = hostCopy(A);
+  L0.gid = m.fineIds;
+  L0.plan = m.finePlan;
+  m.levels.push_back(std::move(L0));
+  m.finishLevel(exec, m.levels.back(), 0);
+  while (static_cast<int>(m.levels.size()) < m.opt.maxLevels && m.info.back().rows > m.opt.coarseSize)
+    if (!m.coarsen(exec, m.levels.size() - 1)) break;
+  MFSI_CHECK(m.info.back().rows <= 20000, "distributed AMG: the coarsest level still has "
+                                              << m.info.back().rows << " rows (raise maxLevels)");
+  m.gatherCoarsest(exec);
+}
+
+void DistributedAmg::apply(const ExecSpace& exec, const ConstRealView& r, const RealView& z) {
+  Impl& m = *impl_;
+  MFSI_CHECK(!m.levels.empty(), "distributed AMG: apply before setup");
+  Impl::Level& L = m.levels.front();
+  const lid_t n = L.hA.nRows;
+  Kokkos::deep_copy(exec, Kokkos::subview(L.b, std::make_pair(0, n)), Kokkos::subview(r, std::make_pair(0, n)));
+  m.cycle(exec, 0);
+  Kokkos::deep_copy(exec, Kokkos::subview(z, std::make_pair(0, n)), Kokkos::subview(L.x, std::make_pair(0, n)));
+}
+
+}  // namespace mfsi

@@ -1,0 +1,69 @@
+#pragma once
+/// \file
+/// \brief Smoothed-aggregation AMG across MPI ranks, for the pressure Poisson equation of a
+/// decomposed mesh (rows: owned cells; columns: owned cells, then ghosts).
+///
+/// Method (as kernels/Amg.hpp, distributed the way ML/MueLu's "uncoupled" aggregation is):
+///  - aggregation is decoupled: each rank aggregates its own rows, over its owned-owned strong
+///    couplings only (greedy three phases), so no aggregate crosses a rank boundary;
+///  - the prolongator is smoothed, P = (I - omega D^{-1} A) P_tent, omega = damping / lambda_max;
+///    its rows reach across rank boundaries (a ghost neighbour's aggregate is a ghost column), so
+///    the coarse operators keep the coupling between ranks: A_c = R (A P) with R = P^T, rows of P
+///    and of A P sent to the ranks that hold them as ghosts (core/parallel/RowExchange);
+///  - each level has its own halo (the coarse ghosts a rank's rows and prolongator touch);
+///  - once a level has at most `coarseSize` rows over all ranks it is gathered onto every rank
+///    and solved by a dense pseudo-inverse (the same on every rank, so deterministic);
+///  - symmetric V-cycle with first-kind Chebyshev smoothing in D^{-1} A (lambda_max from power
+///    iterations), every product after a halo exchange; every sum in a fixed order.
+/// One rank is the same algorithm with no communication (the reference the distributed
+/// iteration counts are compared with). The serial kernels/Amg.hpp remains the one-rank solver of
+/// the fluid (lattice fast paths, float cycle); this one is simpler and double throughout.
+#include "core/parallel/LocalMesh.hpp"
+#include "kernels/Preconditioner.hpp"
+
+#include <mpi.h>
+
+#include <cstdint>
+#include <memory>
+#include <vector>
+
+namespace mfsi {
+
+struct DistributedAmgOptions {
+  double strengthThreshold = 0.08;  ///< finest level; 0 below
+  double prolongationDamping = 4.0 / 3.0;
+  int chebyshevDegree = 2;
+  double chebyshevRatio = 30;       ///< smoothed interval [lambda_max / ratio, lambda_max]
+  std::int64_t coarseSize = 300;    ///< rows over all ranks at or below which a level is solved directly
+  int maxLevels = 16;
+};
+
+/// \brief One level: rows over all ranks, nonzeros over all ranks, and this rank's rows and ghosts.
+struct DistributedAmgLevelInfo {
+  std::int64_t rows = 0;
+  std::int64_t nonzeros = 0;
+  lid_t ownedRows = 0;
+  lid_t ghosts = 0;
+};
+
+class DistributedAmg final : public Preconditioner {
+ public:
+  /// \param comm the ranks (MPI_COMM_NULL or a one-rank communicator: no communication)
+  /// \param plan the halo of the matrix's columns (its ghosts, as core/parallel/LocalMesh)
+  /// \param globalIds global ids of the matrix's columns (owned, then ghosts)
+  DistributedAmg(MPI_Comm comm, const HaloPlan& plan, std::vector<gid_t> globalIds,
+                 const DistributedAmgOptions& options = {});
+  ~DistributedAmg() override;
+
+  void setup(const ExecSpace& exec, const CsrMatrix& A) override;
+  void apply(const ExecSpace& exec, const ConstRealView& r, const RealView& z) override;
+  std::string name() const override { return "distributed-amg"; }
+
+  const std::vector<DistributedAmgLevelInfo>& levels() const;
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
+
+}  // namespace mfsi

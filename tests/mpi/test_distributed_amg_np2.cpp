@@ -1,0 +1,30 @@
+// Distributed smoothed-aggregation AMG on 2 ranks (tests/support/DistributedAmgChecks.hpp).
+#include "core/parallel/Partition.hpp"
+#include "support/DistributedAmgChecks.hpp"
+#include "support/LocalParts.hpp"
+
+using namespace mfsi;
+
+namespace {
+HexMeshInput box(std::array<int, 3> n) {
+  BlockMeshSpec spec = boxSpec({0, 0, 0}, {1, 1, 1}, n);
+  spec.blocks[0].patches[0] = "xmin";
+  return generateBlockMesh(spec);
+}
+}  // namespace
+
+TEST(DistributedAmg, MetisPartsGiveTheOneProcessAnswerWithinTwoIterations) {
+  const HexMeshInput in = box({24, 24, 24});
+  PartitionOptions opt;
+  opt.parts = 2;
+  const auto [one, many] = test::checkDistributedAmg(in, partitionCells(in, opt).cellRank);
+  EXPECT_LE(many, one + 2);
+  EXPECT_LE(one, 30);  // Jacobi-CG takes over 100 here
+}
+
+TEST(DistributedAmg, ARandomPartitionStillConverges) {
+  // Every cell on a random rank: aggregates are single cells, the hierarchy is poor, the answer
+  // must still be the same.
+  const HexMeshInput in = box({12, 12, 12});
+  test::checkDistributedAmg(in, test::randomPartition(in.cells.size(), 2));
+}

@@ -1,0 +1,73 @@
+#pragma once
+/// \file
+/// \brief The distributed AMG tests (tests/mpi/test_distributed_amg_np*.cpp): AMG-preconditioned
+/// CG on the cell Laplacian of a box, on every rank's part, against the same preconditioner on
+/// the whole mesh in one process: the same answer, and the iterations the decoupled aggregation
+/// costs.
+#include "kernels/DistributedAmg.hpp"
+#include "support/DistributedLaplacian.hpp"
+
+namespace mfsi::test {
+
+struct AmgSolve {
+  LaplacianSolve solve;
+  std::vector<DistributedAmgLevelInfo> levels;
+};
+
+inline AmgSolve solveWithAmg(MPI_Comm comm, const HexMesh& mesh, const HaloPlan& plan, const Halo* halo) {
+  RealView b;
+  const CellCsr csr = laplacian(mesh, "xmin", b);
+  auto gid = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), mesh.cellGlobalIds());
+  DistributedAmg amg(comm, plan, std::vector<gid_t>(gid.data(), gid.data() + gid.extent(0)));
+  const ExecSpace exec;
+  amg.setup(exec, csr.matrix);
+  KrylovOptions opt;
+  opt.relTol = 1e-12;
+  opt.maxIterations = 500;
+  ConjugateGradient cg(opt, comm == MPI_COMM_SELF ? SolverComm{} : SolverComm(comm, halo));
+  RealView x("test::x", mesh.nCells());
+  const KrylovResult r = cg.solve(exec, csr.matrix, b, x, amg);
+  AmgSolve s;
+  s.solve.iterations = r.iterations;
+  s.solve.converged = r.status == KrylovStatus::Converged;
+  auto hx = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), x);
+  for (lid_t c = 0; c < mesh.nOwnedCells(); ++c) s.solve.x[gid(c)] = hx(c);
+  s.levels = amg.levels();
+  return s;
+}
+
+/// AMG-CG on the whole mesh (one process) and on every rank's part; returns the two iteration
+/// counts after checking the answers agree to 1e-9.
+inline std::pair<int, int> checkDistributedAmg(const HexMeshInput& in, const std::vector<int>& cellRank) {
+  int ranks = 1, rank = 0;
+  MPI_Comm_size(MPI_COMM_WORLD, &ranks);
+  MPI_Comm_rank(MPI_COMM_WORLD, &rank);
+  const HexMesh global = buildHexMesh(in);
+  const LocalMeshPart whole = localMeshPart(global, std::vector<int>(global.nCells(), 0), 1, 0);
+  const AmgSolve one = solveWithAmg(MPI_COMM_SELF, global, whole.cells, nullptr);
+  EXPECT_TRUE(one.solve.converged);
+  EXPECT_GE(one.levels.size(), 2u);
+
+  const LocalMeshPart part = localMeshPart(global, cellRank, ranks, rank);
+  const HexMesh local = buildHexMesh(part.input);
+  const Halo halo(MPI_COMM_WORLD, part.cells);
+  const AmgSolve dist = solveWithAmg(MPI_COMM_WORLD, local, part.cells, &halo);
+  EXPECT_TRUE(dist.solve.converged);
+  double worst = 0;
+  for (const auto& [g, v] : dist.solve.x)
+    worst = std::max(worst, std::abs(v - one.solve.x.at(g)) / std::abs(one.solve.x.at(g)));
+  EXPECT_LT(worst, 1e-9) << "rank " << rank;
+  int its = dist.solve.iterations, minIts = 0, maxIts = 0;
+  MPI_Allreduce(&its, &minIts, 1, MPI_INT, MPI_MIN, MPI_COMM_WORLD);
+  MPI_Allreduce(&its, &maxIts, 1, MPI_INT, MPI_MAX, MPI_COMM_WORLD);
+  EXPECT_EQ(minIts, maxIts);
+  if (rank == 0) {
+    std::printf("AMG-CG to 1e-12: %d iterations on one process, %d on %d ranks; levels (rows):", one.solve.iterations,
+                dist.solve.iterations, ranks);
+    for (const auto& l : dist.levels) std::printf(" %lld", static_cast<long long>(l.rows));
+    std::printf("\n");
+  }
+  return {one.solve.iterations, dist.solve.iterations};
+}
+
+}  // namespace mfsi::test
