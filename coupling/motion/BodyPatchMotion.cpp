@@ -44,14 +44,14 @@ std::vector<int> BodyPatchMotion::patchIndices(const HexMesh& mesh, const std::s
   return out;
 }
 
-void BodyPatchMotion::apply(const ExecSpace& exec, const RigidTransform& T, const Real3View& displacement) const {
+void BodyPatchMotion::apply(const ExecSpace& exec, const RigidPlacement& T, const Real3View& displacement) const {
   const IndexView nodes = nodes_;
   const Real3View X = reference_;
   const Real3View d = displacement;
-  const real c00 = T.c0[0], c01 = T.c0[1], c02 = T.c0[2];
-  const real c0 = T.c[0], c1 = T.c[1], c2 = T.c[2];
-  const real q00 = T.Q[0], q01 = T.Q[1], q02 = T.Q[2], q10 = T.Q[3], q11 = T.Q[4], q12 = T.Q[5], q20 = T.Q[6],
-             q21 = T.Q[7], q22 = T.Q[8];
+  const std::array<real, 15> f = T.flat();
+  const real c00 = f[0], c01 = f[1], c02 = f[2], c0 = f[3], c1 = f[4], c2 = f[5];
+  const real q00 = f[6], q01 = f[7], q02 = f[8], q10 = f[9], q11 = f[10], q12 = f[11], q20 = f[12], q21 = f[13],
+             q22 = f[14];
   Kokkos::parallel_for(
       "mfsi::coupling::bodyPatch::displacement", RangePolicy(exec, 0, nNodes()), KOKKOS_LAMBDA(lid_t i) {
         const lid_t v = nodes(i);

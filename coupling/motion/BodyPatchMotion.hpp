@@ -9,19 +9,13 @@
 /// ones, so its displacement from the reference is x - X. Written into the mesh motion's
 /// prescribed displacements; the interior follows by the point-Laplacian.
 #include "core/HexMesh.hpp"
+#include "core/RigidPlacement.hpp"
 
 #include <array>
 #include <string>
 #include <vector>
 
 namespace mfsi::coupling {
-
-/// \brief A rigid motion relative to the start configuration: x = c + Q (X - c0), Q = R R0^T.
-struct RigidTransform {
-  std::array<double, 3> c0{0, 0, 0};  ///< centre of mass at the start
-  std::array<double, 3> c{0, 0, 0};   ///< centre of mass now
-  std::array<double, 9> Q{1, 0, 0, 0, 1, 0, 0, 0, 1};  ///< row-major rotation from the start to now
-};
 
 class BodyPatchMotion {
  public:
@@ -38,8 +32,8 @@ class BodyPatchMotion {
   /// Node indices (host copy, sorted).
   const std::vector<lid_t>& hostNodes() const { return hostNodes_; }
 
-  /// displacement(node) = c + Q (X - c0) - X for this body's nodes; other entries untouched.
-  void apply(const ExecSpace& exec, const RigidTransform& T, const Real3View& displacement) const;
+  /// displacement(node) = T.apply(X) - X for this body's nodes; other entries untouched.
+  void apply(const ExecSpace& exec, const RigidPlacement& T, const Real3View& displacement) const;
 
  private:
   IndexView nodes_;

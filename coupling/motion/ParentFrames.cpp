@@ -43,19 +43,16 @@ ParentFrames::ParentFrames(const std::vector<std::array<real, 3>>& nodes,
     for (std::size_t b = 0; b < nb; ++b) h(i, b) = hostWeights_[i * nb + b];
   Kokkos::deep_copy(weights_, h);
   frames_ = Kokkos::View<double* [15], MemSpace>("mfsi::coupling::parentFrames::frames", nBodies);
-  std::vector<RigidTransform> identity(static_cast<std::size_t>(nBodies));
+  std::vector<RigidPlacement> identity(static_cast<std::size_t>(nBodies));
   setTransforms(identity);
 }
 
-void ParentFrames::setTransforms(const std::vector<RigidTransform>& transforms) {
+void ParentFrames::setTransforms(const std::vector<RigidPlacement>& transforms) {
   MFSI_CHECK(static_cast<int>(transforms.size()) == nBodies_, "parent frames: one transform per body expected");
   auto h = Kokkos::create_mirror_view(frames_);
   for (int b = 0; b < nBodies_; ++b) {
-    for (int k = 0; k < 3; ++k) {
-      h(b, k) = transforms[b].c0[k];
-      h(b, 3 + k) = transforms[b].c[k];
-    }
-    for (int k = 0; k < 9; ++k) h(b, 6 + k) = transforms[b].Q[k];
+    const std::array<real, 15> f = transforms[b].flat();
+    for (int k = 0; k < 15; ++k) h(b, k) = f[k];
   }
   Kokkos::deep_copy(frames_, h);
 }

@@ -7,7 +7,7 @@
 /// The FEM solves the membrane clamped at zero displacement relative to its frame; a node at
 /// reference position X with relative displacement u sits at
 ///   x = sum_b w_b (c_b + Q_b (X + u - c0_b))
-/// (each body's rigid motion from the start, see RigidTransform), with weights w_b proportional to
+/// (each body's rigid motion from the start, a RigidPlacement), with weights w_b proportional to
 /// 1 / d_b^2, d_b the distance from X to the nearest node of body b's listed patches (w = 1 for
 /// the body a node lies on; one parent: w = 1 everywhere). A clamped node (u = 0) on a frame is
 /// where that body puts the frame's own nodes, so frame and membrane never gap or overlap, and the
@@ -37,7 +37,7 @@ class ParentFrames {
   double weight(std::size_t i, int slot) const { return hostWeights_[i * static_cast<std::size_t>(nBodies_) + slot]; }
 
   /// The bodies' current rigid motions (one per slot).
-  void setTransforms(const std::vector<RigidTransform>& transforms);
+  void setTransforms(const std::vector<RigidPlacement>& transforms);
 
   /// displacement(fluidNode(i)) = sum_b w_ib (c_b + Q_b (X_i + u_i - c0_b)) - X_i for the
   /// membrane's nodes, with u the relative displacement (3 per node) and X the reference positions.

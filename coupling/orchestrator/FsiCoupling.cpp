@@ -424,15 +424,9 @@ void FsiCoupling::placeBodies(const InterfaceVector& x) {
   sys.model().kinematics(stepEnd_, q, zero, zero, kin);
   for (std::size_t slot = 0; slot < bodies_.size(); ++slot) {
     const CoupledBody& b = bodies_[slot];
-    coupling::RigidTransform& T = transforms_[slot];
-    const Eigen::Vector3d c = kin.bodies[b.index].com;
-    const Eigen::Matrix3d Q = kin.bodies[b.index].frame.rotation * b.rotation0.transpose();
-    for (int k = 0; k < 3; ++k) {
-      T.c0[k] = b.com0[k];
-      T.c[k] = c[k];
-      for (int j = 0; j < 3; ++j) T.Q[3 * k + j] = Q(k, j);
-    }
-    b.motion.apply(exec_, T, smoother_->displacement());
+    transforms_[slot] =
+        placementFromStart(b.com0, b.rotation0, kin.bodies[b.index].com, kin.bodies[b.index].frame.rotation);
+    b.motion.apply(exec_, transforms_[slot], smoother_->displacement());
   }
   for (Panel& p : panels_)
     if (p.mounted) p.parents.setTransforms(transforms_);
@@ -686,9 +680,8 @@ void FsiCoupling::saveState(io::StateWriter& w) const {
   }
   std::vector<double> tr;
   for (const auto& T : transforms_) {
-    tr.insert(tr.end(), T.c0.begin(), T.c0.end());
-    tr.insert(tr.end(), T.c.begin(), T.c.end());
-    tr.insert(tr.end(), T.Q.begin(), T.Q.end());
+    const std::array<real, 15> f = T.flat();  // origin, placed origin, rotation
+    tr.insert(tr.end(), f.begin(), f.end());
   }
   w.put("transforms", tr);
   if (smoother_) {
@@ -719,12 +712,7 @@ void FsiCoupling::loadState(const io::StateReader& r) {
     p.haveFiltered = pr.boolean("haveFiltered");
   }
   const auto tr = r.doubles("transforms", 15 * static_cast<long long>(transforms_.size()));
-  for (std::size_t b = 0; b < transforms_.size(); ++b) {
-    auto& T = transforms_[b];
-    std::copy(tr.begin() + 15 * b, tr.begin() + 15 * b + 3, T.c0.begin());
-    std::copy(tr.begin() + 15 * b + 3, tr.begin() + 15 * b + 6, T.c.begin());
-    std::copy(tr.begin() + 15 * b + 6, tr.begin() + 15 * b + 15, T.Q.begin());
-  }
+  for (std::size_t b = 0; b < transforms_.size(); ++b) transforms_[b] = RigidPlacement::fromFlat(tr.data() + 15 * b);
   if (!transforms_.empty())
     for (Panel& p : panels_)
       if (p.mounted) p.parents.setTransforms(transforms_);

@@ -155,7 +155,7 @@ class FsiCoupling final : public Module {
   std::unique_ptr<RigidModule> rigid_;
   std::vector<CoupledBody> bodies_;
   Eigen::Index bodyOffset_ = 0;  ///< the free coordinates of the rigid system in the interface vector
-  std::vector<coupling::RigidTransform> transforms_;  ///< per coupled body: its motion at the iterate being placed
+  std::vector<RigidPlacement> transforms_;  ///< per coupled body: its motion at the iterate being placed
   std::unique_ptr<coupling::MeshSmoother> smoother_;
   std::unique_ptr<coupling::Acceleration> acceleration_;
   Eigen::Index size_ = 0;

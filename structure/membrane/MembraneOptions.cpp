@@ -35,30 +35,6 @@ const char* toString(MembraneTimeIntegrator v) {
   return v == MembraneTimeIntegrator::Newmark ? "newmark" : "generalizedAlpha";
 }
 
-std::array<real, 3> MembraneRigidTransform::apply(const std::array<real, 3>& X) const {
-  std::array<real, 3> x{};
-  for (int i = 0; i < 3; ++i) {
-    x[i] = origin[i] + translation[i];
-    for (int j = 0; j < 3; ++j) x[i] += rotation[i][j] * (X[j] - origin[j]);
-  }
-  return x;
-}
-
-MembraneRigidTransform MembraneRigidTransform::rotationAbout(const std::array<real, 3>& axis, real angle,
-                                                             const std::array<real, 3>& origin) {
-  const real l = std::sqrt(axis[0] * axis[0] + axis[1] * axis[1] + axis[2] * axis[2]);
-  MFSI_CHECK(l > 0, "rotation axis must be non-zero");
-  const real k[3] = {axis[0] / l, axis[1] / l, axis[2] / l};
-  const real c = std::cos(angle), s = std::sin(angle);
-  MembraneRigidTransform t;
-  t.origin = origin;
-  // Rodrigues: R = c I + s [k]x + (1 - c) k k^T.
-  const real K[3][3] = {{0, -k[2], k[1]}, {k[2], 0, -k[0]}, {-k[1], k[0], 0}};
-  for (int i = 0; i < 3; ++i)
-    for (int j = 0; j < 3; ++j) t.rotation[i][j] = (i == j ? c : 0) + s * K[i][j] + (1 - c) * k[i] * k[j];
-  return t;
-}
-
 std::vector<MembraneEdgeBeam> makeEdgeBeams(const std::vector<lid_t>& chain, real axialStiffness, bool closed,
                                             bool tensionOnly) {
   std::vector<MembraneEdgeBeam> out;

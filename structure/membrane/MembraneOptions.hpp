@@ -3,6 +3,7 @@
 /// \brief Plain option structs of the membrane solver (filled by a configuration layer; no YAML
 /// here): material and wrinkling, static solvers, dynamics, loads, boundary conditions and
 /// reinforcements.
+#include "core/RigidPlacement.hpp"
 #include "structure/membrane/MembraneMaterial.hpp"
 
 #include <array>
@@ -140,24 +141,12 @@ struct MembraneLoads {
   Real3View nodeForce;  ///< optional external nodal forces (N), size nNodes
 };
 
-/// \brief Rigid placement x = origin + R (X - origin) + translation.
-struct MembraneRigidTransform {
-  std::array<std::array<real, 3>, 3> rotation{{{1, 0, 0}, {0, 1, 0}, {0, 0, 1}}};
-  std::array<real, 3> translation{0, 0, 0};
-  std::array<real, 3> origin{0, 0, 0};
-
-  std::array<real, 3> apply(const std::array<real, 3>& X) const;
-  /// Rotation by `angle` (rad) about the unit `axis` through `origin`.
-  static MembraneRigidTransform rotationAbout(const std::array<real, 3>& axis, real angle,
-                                              const std::array<real, 3>& origin);
-};
-
 /// \brief Clamped nodes. Without a frame the displacement is zero (or `offsets`); with a frame
 /// the node goes to frame(t).apply(X + offset): clamped to a moving parent.
 struct MembraneClamp {
   std::vector<lid_t> nodes;
   std::vector<std::array<real, 3>> offsets;  ///< optional per-node displacement before the frame
-  std::function<MembraneRigidTransform(real)> frame;  ///< optional, time -> placement
+  std::function<RigidPlacement(real)> frame;  ///< optional, time -> placement
 };
 
 /// \brief A linear spring from a node to a fixed anchor point: force k (L - L0) along the line

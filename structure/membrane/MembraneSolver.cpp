@@ -190,7 +190,7 @@ void MembraneSolver::setupClamps() {
 void MembraneSolver::clampTargets(real time) {
   auto h = Kokkos::create_mirror_view(clampTarget_);
   std::vector<std::size_t> index(boundary_.clamps.size(), 0);
-  std::vector<MembraneRigidTransform> frames(boundary_.clamps.size());
+  std::vector<RigidPlacement> frames(boundary_.clamps.size());
   for (std::size_t g = 0; g < boundary_.clamps.size(); ++g)
     if (boundary_.clamps[g].frame) frames[g] = boundary_.clamps[g].frame(time);
   for (std::size_t i = 0; i < clampHost_.size(); ++i) {

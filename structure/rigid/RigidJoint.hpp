@@ -2,6 +2,7 @@
 /// \file
 /// \brief Kinematics of one joint frame: how an elementary axis (Px ... Rz) or a fixed offset moves
 /// a frame, propagating position, orientation, velocity and acceleration from parent to child.
+#include "core/RigidPlacement.hpp"
 #include "structure/rigid/RigidOptions.hpp"
 
 #include <Eigen/Dense>
@@ -28,6 +29,20 @@ struct RigidFrameMotion {
     return acceleration + alpha.cross(d) + omega.cross(omega.cross(d));
   }
 };
+
+/// \brief The placement that takes a body from its start (centre c0, orientation R0) to now (c,
+/// R): x = c + R R0^T (X - c0), the rigid frames' motion in the project's one placement type.
+inline RigidPlacement placementFromStart(const Eigen::Vector3d& c0, const Eigen::Matrix3d& R0,
+                                         const Eigen::Vector3d& c, const Eigen::Matrix3d& R) {
+  RigidPlacement p;
+  const Eigen::Matrix3d Q = R * R0.transpose();
+  for (int k = 0; k < 3; ++k) {
+    p.origin[k] = c0[k];
+    p.placed[k] = c[k];
+    for (int j = 0; j < 3; ++j) p.rotation[k][j] = Q(k, j);
+  }
+  return p;
+}
 
 /// \brief Rotation by angle about the x (0), y (1) or z (2) axis.
 inline Eigen::Matrix3d rigidAxisRotation(int direction, double angle) {

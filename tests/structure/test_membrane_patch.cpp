@@ -32,7 +32,7 @@ void runPatch(MembraneElementType type) {
   F(1, 0) = 0.02;
   F(1, 1) = 1.04;
   const double angle = 0.4;
-  const MembraneRigidTransform R = MembraneRigidTransform::rotationAbout({1, 1, 1}, angle, {0, 0, 0});
+  const RigidPlacement R = RigidPlacement::rotationAbout({1, 1, 1}, angle, {0, 0, 0});
 
   MembraneClamp clamp;
   clamp.nodes = mesh.boundaryNodes();

@@ -324,7 +324,7 @@ AnnulusResult shearedAnnulus(const AnnulusCase& c, MembraneWrinklingModel model)
   MembraneClamp hub;
   hub.nodes = mesh.nodeSet("inner");
   const double phi = c.phi;
-  hub.frame = [phi](real) { return MembraneRigidTransform::rotationAbout({0, 0, 1}, phi, {0, 0, 0}); };
+  hub.frame = [phi](real) { return RigidPlacement::rotationAbout({0, 0, 1}, phi, {0, 0, 0}); };
   bc.clamps.push_back(hub);
   MembraneOptions opt;
   opt.material = {c.E, c.nu, c.h, 0, c.sigma0() * c.h};
