@@ -20,8 +20,13 @@ void QuasiNewton::beginStep() {
   Acceleration::beginStep();
   ++stepIndex_;
   const long oldest = stepIndex_ - options_.iqnReuseCols;
-  columns_.erase(std::remove_if(columns_.begin(), columns_.end(), [&](const Column& c) { return c.step < oldest; }),
-                 columns_.end());
+  // Columns are newest first, so the ones that age out are at the back.
+  while (!columns_.empty() && columns_.back().step < oldest) {
+    columns_.pop_back();
+    if (qrValid_) removeColumn(columns_.size());
+  }
+  MFSI_ASSERT(std::none_of(columns_.begin(), columns_.end(), [&](const Column& c) { return c.step < oldest; }),
+              "IQN history out of step order");
   havePrevious_ = false;
   aitken_.reset();
 }
@@ -39,6 +44,16 @@ void QuasiNewton::saveState(io::StateWriter& w) const {
   w.put("columnSteps", steps);
   w.put("V", v);
   w.put("W", wv);
+  // The kept factorisation and the scaling it was made with: a restart continues bit for bit.
+  w.put("blockWeight", std::vector<double>(blockWeight_.data(), blockWeight_.data() + blockWeight_.size()));
+  w.putBool("qrValid", qrValid_);
+  if (qrValid_) {
+    std::vector<double> q, rr(qr_.r.data(), qr_.r.data() + qr_.r.size());
+    for (const auto& c : qr_.q) q.insert(q.end(), c.data(), c.data() + c.size());
+    w.put("Q", q);
+    w.put("R", rr);
+    w.put("qrNorm", qrNorm_);
+  }
 }
 
 void QuasiNewton::loadState(const io::StateReader& r) {
@@ -57,10 +72,25 @@ void QuasiNewton::loadState(const io::StateReader& r) {
     c.step = static_cast<long>(steps[i]);
     columns_.push_back(std::move(c));
   }
+  qrValid_ = false;
+  if (r.has("blockWeight")) {
+    const auto bw = r.doubles("blockWeight", blockWeight_.size());
+    blockWeight_ = Eigen::Map<const Eigen::VectorXd>(bw.data(), static_cast<Eigen::Index>(bw.size()));
+  }
+  if (r.has("qrValid") && r.boolean("qrValid")) {
+    const auto k = static_cast<long long>(columns_.size());
+    const auto q = r.doubles("Q", k * size_), rr = r.doubles("R", k * k);
+    qr_.q.clear();
+    for (long long i = 0; i < k; ++i) qr_.q.push_back(Eigen::Map<const InterfaceVector>(q.data() + i * size_, size_));
+    qr_.r = Eigen::Map<const Eigen::MatrixXd>(rr.data(), static_cast<Eigen::Index>(k), static_cast<Eigen::Index>(k));
+    qrNorm_ = r.doubles("qrNorm", k);
+    qrValid_ = true;
+  }
 }
 
 void QuasiNewton::restart() {
   columns_.clear();
+  qrValid_ = false;
   havePrevious_ = false;
   aitken_.reset();
 }
@@ -73,10 +103,21 @@ void QuasiNewton::setScaling(const InterfaceVector& r) {
   for (Eigen::Index b = 0; b < nb; ++b) n2[b] = r.segment(layout_[b].offset, layout_[b].size).squaredNorm();
   comm_.globalSum(n2.data(), static_cast<int>(nb));
   const double largest = nb > 0 ? std::sqrt(n2.maxCoeff()) : 0.0;
+  const Eigen::VectorXd before = blockWeight_;
   for (Eigen::Index b = 0; b < nb; ++b) {
     const double nrm = std::sqrt(n2[b]) > 0 ? std::sqrt(n2[b]) : largest;
     blockWeight_[b] = nrm > 0 ? 1.0 / nrm : 1.0;
   }
+  // The same factor on every block scales R and the norms (Q stays); anything else: rebuild.
+  if (!qrValid_ || nb == 0) return;
+  const double f = blockWeight_[0] / before[0];
+  for (Eigen::Index b = 1; b < nb; ++b)
+    if (blockWeight_[b] != f * before[b]) {
+      qrValid_ = false;
+      return;
+    }
+  qr_.r *= f;
+  for (double& n : qrNorm_) n *= f;
 }
 
 InterfaceVector QuasiNewton::scaled(const InterfaceVector& a) const {
@@ -90,46 +131,161 @@ void QuasiNewton::record(const InterfaceVector& xt, const InterfaceVector& r) {
   if (!havePrevious_) setScaling(r);
   if (havePrevious_) {
     columns_.push_front(Column{r - rPrevious_, xt - xtPrevious_, stepIndex_});
-    while (static_cast<int>(columns_.size()) > options_.iqnMaxCols) columns_.pop_back();
+    if (qrValid_) insertFront(scaled(columns_.front().v));
+    while (static_cast<int>(columns_.size()) > options_.iqnMaxCols) {
+      columns_.pop_back();
+      if (qrValid_) removeColumn(columns_.size());
+    }
   }
   rPrevious_ = r;
   xtPrevious_ = xt;
   havePrevious_ = true;
 }
 
-int QuasiNewton::factorise(Factorisation& f) {
-  f.q.clear();
+void QuasiNewton::rebuild() {
+  qr_.q.clear();
+  qrNorm_.clear();
   std::vector<Eigen::VectorXd> rcols;  // column j of R (first j+1 entries)
-  int dropped = 0;
   for (auto it = columns_.begin(); it != columns_.end();) {
     InterfaceVector q = scaled(it->v);
     const double original = norm(q);
-    Eigen::VectorXd rc(static_cast<Eigen::Index>(f.q.size()) + 1);
+    Eigen::VectorXd rc(static_cast<Eigen::Index>(qr_.q.size()) + 1);
     // Modified Gram-Schmidt, twice ("twice is enough", Giraud et al. 2005): the second pass
     // restores orthogonality that the first loses on nearly dependent columns.
     rc.setZero();
     for (int pass = 0; pass < 2; ++pass) {
-      for (std::size_t i = 0; i < f.q.size(); ++i) {
-        const double c = dot(f.q[i], q);
+      for (std::size_t i = 0; i < qr_.q.size(); ++i) {
+        const double c = dot(qr_.q[i], q);
         rc[static_cast<Eigen::Index>(i)] += c;
-        q -= c * f.q[i];
+        q -= c * qr_.q[i];
       }
     }
     const double rest = norm(q);
     if (!(original > 0) || !std::isfinite(rest) || rest <= options_.iqnFilterEps * original) {
       it = columns_.erase(it);  // QR2 filter: nothing new in this column
-      ++dropped;
       continue;
     }
-    rc[static_cast<Eigen::Index>(f.q.size())] = rest;
-    f.q.push_back(q / rest);
+    rc[static_cast<Eigen::Index>(qr_.q.size())] = rest;
+    qr_.q.push_back(q / rest);
+    qrNorm_.push_back(original);
     rcols.push_back(rc);
     ++it;
   }
-  const auto k = static_cast<Eigen::Index>(f.q.size());
-  f.r = Eigen::MatrixXd::Zero(k, k);
-  for (Eigen::Index j = 0; j < k; ++j) f.r.col(j).head(j + 1) = rcols[static_cast<std::size_t>(j)];
-  return dropped;
+  const auto k = static_cast<Eigen::Index>(qr_.q.size());
+  qr_.r = Eigen::MatrixXd::Zero(k, k);
+  for (Eigen::Index j = 0; j < k; ++j) qr_.r.col(j).head(j + 1) = rcols[static_cast<std::size_t>(j)];
+  qrValid_ = true;
+}
+
+namespace {
+/// Givens rotation (c, s) with c a + s b = hypot(a, b), -s a + c b = 0.
+std::pair<double, double> givens(double a, double b) {
+  const double h = std::hypot(a, b);
+  return h > 0 ? std::make_pair(a / h, b / h) : std::make_pair(1.0, 0.0);
+}
+/// Rows i and i + 1 of R by (c, s) from column `from` on, and the basis columns the same way
+/// (Q R is unchanged: Q G^T G R).
+void rotate(Eigen::MatrixXd& R, std::vector<InterfaceVector>& q, Eigen::Index i, double c, double s,
+            Eigen::Index from) {
+  for (Eigen::Index j = from; j < R.cols(); ++j) {
+    const double a = R(i, j), b = R(i + 1, j);
+    R(i, j) = c * a + s * b;
+    R(i + 1, j) = -s * a + c * b;
+  }
+  InterfaceVector& qa = q[static_cast<std::size_t>(i)];
+  InterfaceVector& qb = q[static_cast<std::size_t>(i + 1)];
+  const InterfaceVector t = qa;
+  qa = c * t + s * qb;
+  qb = -s * t + c * qb;
+}
+}  // namespace
+
+void QuasiNewton::insertFront(const InterfaceVector& sv) {
+  const auto k = static_cast<Eigen::Index>(qr_.q.size());
+  const double original = norm(sv);
+  InterfaceVector u = sv;
+  Eigen::VectorXd s = Eigen::VectorXd::Zero(k);
+  for (int pass = 0; pass < 2; ++pass)
+    for (Eigen::Index i = 0; i < k; ++i) {
+      const double c = dot(qr_.q[static_cast<std::size_t>(i)], u);
+      s[i] += c;
+      u -= c * qr_.q[static_cast<std::size_t>(i)];
+    }
+  const double rho = norm(u);
+  if (!(original > 0) || !std::isfinite(rho) || rho <= 1e-12 * original) {
+    qrValid_ = false;  // dependent on the history (or degenerate): factorise() rebuilds and filters
+    return;
+  }
+  // [S v, S V] = [Q, u / rho] T with T = [[s, R], [rho, 0]]; rotations from the bottom up make T
+  // upper triangular.
+  Eigen::MatrixXd T = Eigen::MatrixXd::Zero(k + 1, k + 1);
+  T.col(0).head(k) = s;
+  T(k, 0) = rho;
+  T.block(0, 1, k, k) = qr_.r;
+  qr_.q.push_back(u / rho);
+  for (Eigen::Index i = k; i >= 1; --i) {
+    const auto [c, sn] = givens(T(i - 1, 0), T(i, 0));
+    rotate(T, qr_.q, i - 1, c, sn, 0);
+    T(i, 0) = 0;
+  }
+  qr_.r = T;
+  qrNorm_.insert(qrNorm_.begin(), original);
+}
+
+void QuasiNewton::removeColumn(std::size_t j) {
+  const auto k = static_cast<Eigen::Index>(qr_.q.size());
+  const auto jj = static_cast<Eigen::Index>(j);
+  MFSI_ASSERT(jj < k, "IQN: removing column " << j << " of " << k);
+  // Without column j, R is upper Hessenberg from column j on: rotations restore it.
+  Eigen::MatrixXd R(k, k - 1);
+  R.leftCols(jj) = qr_.r.leftCols(jj);
+  R.rightCols(k - 1 - jj) = qr_.r.rightCols(k - 1 - jj);
+  for (Eigen::Index i = jj; i < k - 1; ++i) {
+    const auto [c, sn] = givens(R(i, i), R(i + 1, i));
+    rotate(R, qr_.q, i, c, sn, i);
+    R(i + 1, i) = 0;
+  }
+  qr_.r = R.topRows(k - 1);
+  qr_.q.pop_back();
+  qrNorm_.erase(qrNorm_.begin() + jj);
+}
+
+double QuasiNewton::factorisationDefect() const {
+  if (!qrValid_ || qr_.q.empty()) return 0;
+  const auto k = static_cast<Eigen::Index>(qr_.q.size());
+  double scale = 0, defect = 0;
+  for (Eigen::Index j = 0; j < k; ++j) {
+    const InterfaceVector sv = scaled(columns_[static_cast<std::size_t>(j)].v);
+    InterfaceVector qr = InterfaceVector::Zero(sv.size());
+    for (Eigen::Index i = 0; i <= j; ++i) qr += qr_.r(i, j) * qr_.q[static_cast<std::size_t>(i)];
+    scale = std::max(scale, sv.cwiseAbs().maxCoeff());
+    defect = std::max(defect, (qr - sv).cwiseAbs().maxCoeff());
+  }
+  double orth = 0;
+  for (Eigen::Index i = 0; i < k; ++i)
+    for (Eigen::Index j = 0; j < k; ++j)
+      orth = std::max(orth, std::abs(dot(qr_.q[static_cast<std::size_t>(i)], qr_.q[static_cast<std::size_t>(j)]) -
+                                     (i == j ? 1.0 : 0.0)));
+  return std::max(scale > 0 ? defect / scale : defect, orth);
+}
+
+int QuasiNewton::factorise() {
+  const std::size_t before = columns_.size();
+  if (!qrValid_) {
+    rebuild();
+    return static_cast<int>(before - columns_.size());
+  }
+  // QR2 filter on the kept factorisation: |R(i, i)| is column i's part orthogonal to the newer ones.
+  for (std::size_t i = 0; i < columns_.size();) {
+    const double d = std::abs(qr_.r(static_cast<Eigen::Index>(i), static_cast<Eigen::Index>(i)));
+    if (!(qrNorm_[i] > 0) || !std::isfinite(d) || d <= options_.iqnFilterEps * qrNorm_[i]) {
+      columns_.erase(columns_.begin() + static_cast<std::ptrdiff_t>(i));
+      removeColumn(i);
+      continue;
+    }
+    ++i;
+  }
+  return static_cast<int>(before - columns_.size());
 }
 
 void QuasiNewton::relax(const InterfaceVector& r, InterfaceVector& x, AccelerationReport& report) {
@@ -146,8 +302,8 @@ void IqnIls::step(const InterfaceVector& xt, const InterfaceVector& r, Interface
     relax(r, x, report);
     return;
   }
-  Factorisation f;
-  report.dropped = factorise(f);
+  report.dropped = factorise();
+  const Factorisation& f = factorisation();
   const auto k = static_cast<Eigen::Index>(f.q.size());
   if (k == 0) {
     relax(r, x, report);

@@ -14,9 +14,16 @@ namespace mfsi::coupling {
 /// w = xt_k - xt_{k-1} joins the front (newest first); at most iqnMaxCols are kept, and columns of
 /// the last iqnReuseCols steps survive beginStep. Columns are stored unscaled; the factorisation
 /// works on block-scaled columns S v (each block divided by the norm of its residual at the
-/// step's first pass, so membrane displacements and body DOFs weigh alike), rebuilt at every
-/// update by modified Gram-Schmidt with the QR2 filter, which drops for good any column whose
-/// part orthogonal to the newer ones is below iqnFilterEps of its norm.
+/// step's first pass, so membrane displacements and body DOFs weigh alike). The QR2 filter drops
+/// for good any column whose part orthogonal to the newer ones is below iqnFilterEps of its norm.
+///
+/// The factorisation is kept up to date instead of rebuilt (as preCICE's QRFactorization): a new
+/// column enters at the front by one Gram-Schmidt pass and Givens rotations, the oldest leave
+/// from the back for free, a filtered column leaves by Givens rotations: O(n k) per pass for n
+/// unknowns and k columns where a rebuild costs O(n k^2), which is what lets a long history (more
+/// columns, more reused steps) pay for itself. It is rebuilt by modified Gram-Schmidt only when
+/// the blocks' relative scaling changes (several blocks), after a restart or a checkpoint load,
+/// or when a new column is numerically dependent on the history.
 class QuasiNewton : public Acceleration {
  public:
   QuasiNewton(const AccelerationOptions& options, std::vector<InterfaceBlock> layout, const SolverComm& comm);
@@ -26,6 +33,9 @@ class QuasiNewton : public Acceleration {
   void loadState(const io::StateReader& r) override;
   /// Columns in the history now.
   int columns() const { return static_cast<int>(columns_.size()); }
+  /// How far the kept factorisation is from the history (0 when none is kept): the largest of
+  /// max |Q R - S V| / max |S V| and max |Q^T Q - I|. For tests.
+  double factorisationDefect() const;
 
  protected:
   struct Column {
@@ -41,8 +51,10 @@ class QuasiNewton : public Acceleration {
   void restart() override;
   /// Add the newest column pair (from the previous pass) and trim the history.
   void record(const InterfaceVector& xt, const InterfaceVector& r);
-  /// Factorise the scaled history; drops filtered columns; returns how many it dropped.
-  int factorise(Factorisation& f);
+  /// Bring the factorisation of the scaled history up to date and filter it (filtered columns
+  /// leave the history); returns how many it dropped. The result: `factorisation()`.
+  int factorise();
+  const Factorisation& factorisation() const { return qr_; }
   /// S a: the block scaling of this step.
   InterfaceVector scaled(const InterfaceVector& a) const;
   /// A relaxation step x <- x + omega r (Aitken's omega, or omegaInit without history).
@@ -54,7 +66,13 @@ class QuasiNewton : public Acceleration {
 
  private:
   void setScaling(const InterfaceVector& r);
+  void rebuild();
+  void insertFront(const InterfaceVector& sv);
+  void removeColumn(std::size_t j);
   Eigen::VectorXd blockWeight_;  ///< per block of layout_
+  Factorisation qr_;              ///< of the scaled columns_, in their order, while qrValid_
+  std::vector<double> qrNorm_;    ///< |S v| of each column (the filter's reference)
+  bool qrValid_ = false;
   bool havePrevious_ = false;
   InterfaceVector rPrevious_, xtPrevious_;
 };

@@ -209,6 +209,34 @@ TEST(Acceleration, ReusedColumnsChangeIterationsNotResults) {
     EXPECT_LT((fresh[s] - reused[s]).norm(), 10 * tol * fresh[s].norm()) << "step " << s;
 }
 
+TEST(Acceleration, TheKeptFactorisationStaysTheHistorysQr) {
+  // The factorisation is updated, not rebuilt: columns enter at the front (Givens), the oldest
+  // leave at the history's limit and at the reuse window, filtered ones leave from the middle.
+  // After every pass it must still be a QR factorisation of the scaled history.
+  const int n = 10;
+  Affine h = randomAffine(n, 5, 0.9);
+  const InterfaceVector b0 = h.b;
+  AccelerationOptions o = iqn(7, 0.4);
+  o.iqnReuseCols = 2;
+  auto acc = makeAcceleration(o, oneBlock(n));
+  auto* qn = dynamic_cast<mfsi::coupling::QuasiNewton*>(acc.get());
+  ASSERT_NE(qn, nullptr);
+  InterfaceVector x = InterfaceVector::Zero(n);
+  int dropped = 0, limited = 0;
+  for (int step = 0; step < 8; ++step) {
+    h.b = b0 * (1.0 + 0.3 * step);
+    acc->beginStep();
+    for (int k = 0; k < 30 && (h(x) - x).norm() > 1e-10 * x.norm(); ++k) {
+      const AccelerationReport rep = acc->update(h(x), x);
+      dropped += rep.dropped;
+      limited += qn->columns() == 7 ? 1 : 0;
+      EXPECT_LT(qn->factorisationDefect(), 1e-11) << "step " << step << " pass " << k;
+    }
+  }
+  EXPECT_GT(dropped, 0) << "the filter never acted: the test shows less than it should";
+  EXPECT_GT(limited, 0) << "the history never reached its limit";
+}
+
 TEST(Acceleration, BlockScalingMakesIqnIlsIndependentOfUnits) {
   // Two blocks (say metres and radians); expressing the second in units 1e6 times smaller
   // (y2 = 1e6 x2) must not change the iteration: the same iterates up to the change of units.
