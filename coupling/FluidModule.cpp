@@ -1,6 +1,7 @@
 #include "coupling/FluidModule.hpp"
 
 #include "fluid/GhiaTable.hpp"
+#include "fluid/Gradient.hpp"
 #include "fluid/Loads.hpp"
 #include "core/io/HostCopy.hpp"
 
@@ -54,6 +55,13 @@ FluidModule::FluidModule(const HexMesh& mesh, const FluidOptions& options, Fluid
   auto h = Kokkos::create_mirror_view(probeCells_);
   for (std::size_t i = 0; i < n; ++i) h(i) = nearestCell(C, reports_.probes[i].point);
   Kokkos::deep_copy(probeCells_, h);
+  probePoints_ = Real3View("mfsi::fluid::probes::points", n);
+  auto hp = Kokkos::create_mirror_view(probePoints_);
+  for (std::size_t i = 0; i < n; ++i)
+    for (int k = 0; k < 3; ++k) hp(i, k) = reports_.probes[i].point[k];
+  Kokkos::deep_copy(probePoints_, hp);
+  probeGradP_ = Real3View("mfsi::fluid::probes::gradP", mesh.nCells());
+  probeGradU_ = Tensor3View("mfsi::fluid::probes::gradU", mesh.nCells());
 }
 
 std::vector<double> FluidModule::probeValues() const {
@@ -61,11 +69,22 @@ std::vector<double> FluidModule::probeValues() const {
   const RealView values = probeValues_;
   const ConstRealView p = solver_.pressure();
   const ConstReal3View U = solver_.velocity();
+  const ExecSpace exec;
+  const GradientScheme scheme = solver_.options().gradient;
+  cellGradient(exec, scheme, solver_.mesh(), solver_.geometry(), solver_.faceData(), p, solver_.boundaryPressure(),
+               probeGradP_, cells);
+  cellGradient(exec, scheme, solver_.mesh(), solver_.geometry(), solver_.faceData(), U, solver_.boundaryVelocity(),
+               probeGradU_, cells);
+  const ConstReal3View gp = probeGradP_, C = solver_.geometry().cellCentroid, X = probePoints_;
+  const fluid::ConstTensor3View gu = probeGradU_;
   Kokkos::parallel_for(
-      "mfsi::fluid::probes::gather", RangePolicy(ExecSpace(), 0, static_cast<lid_t>(cells.extent(0))),
+      "mfsi::fluid::probes::gather", RangePolicy(exec, 0, static_cast<lid_t>(cells.extent(0))),
       KOKKOS_LAMBDA(lid_t i) {
-        values(4 * i) = p(cells(i));
-        for (int k = 0; k < 3; ++k) values(4 * i + 1 + k) = U(cells(i), k);
+        const lid_t c = cells(i);
+        const real d[3] = {X(i, 0) - C(c, 0), X(i, 1) - C(c, 1), X(i, 2) - C(c, 2)};
+        values(4 * i) = p(c) + gp(c, 0) * d[0] + gp(c, 1) * d[1] + gp(c, 2) * d[2];
+        for (int k = 0; k < 3; ++k)
+          values(4 * i + 1 + k) = U(c, k) + gu(c, 0, k) * d[0] + gu(c, 1, k) * d[1] + gu(c, 2, k) * d[2];
       });
   auto h = Kokkos::create_mirror_view_and_copy(HostSpace(), values);
   return std::vector<double>(h.data(), h.data() + h.extent(0));

@@ -51,7 +51,10 @@ class FluidModule final : public Module {
   /// The running means (null without fluid.means).
   const fluid::RunningMean* means() const { return means_ ? &*means_ : nullptr; }
 
-  /// The probes' cell values now: p, Ux, Uy, Uz per probe (public for nvcc: it launches a kernel).
+  /// The probes' values now: p, Ux, Uy, Uz per probe, each the nearest cell's value corrected by
+  /// the cell's gradient to the probe point (second order; a point on a cell face or node, where
+  /// the nearest cell is a tie decided by round-off, gets the same value from every candidate).
+  /// Public for nvcc: it launches a kernel.
   std::vector<double> probeValues() const;
 
  private:
@@ -60,7 +63,10 @@ class FluidModule final : public Module {
   fluid::FluidSolver solver_;
   FluidReports reports_;
   IndexView probeCells_;  ///< the cells of reports_.probes
+  Real3View probePoints_;
   RealView probeValues_;
+  Real3View probeGradP_;             ///< per cell; only the probe cells' rows are computed
+  fluid::Tensor3View probeGradU_;
   fluid::StepResult last_;
   TimeState step_;  ///< the step begun last
   fluid::RunawayGuard runaway_;

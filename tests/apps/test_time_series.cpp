@@ -39,3 +39,26 @@ TEST(TimeSeries, ForcesPressureDifferencesAndProbesEveryStepEndAtTheSummarysValu
   EXPECT_GT(steps.at("fluid.probe.gap.Ux").back(), 0.3);
   EXPECT_EQ(steps.count("fluid.probe.wake"), 1u);  // the pressure column keeps its name
 }
+
+TEST(TimeSeries, AProbeOnAMeshNodeIsInterpolatedNotTheNearestCell) {
+  // Steady Poiseuille flow (cases/channel.yaml): the pressure falls linearly along x. A probe on
+  // a mesh node (x = 3, y = 0.5: eight cell centres equally near) reads the linear field there,
+  // halfway between the probes at the two cell centres beside it, not either cell's value (which
+  // is what the nearest cell gave, the choice between the two decided by round-off).
+  const std::string dir = mfsi::test::freshDir("time_series_probe_node");
+  auto cfg = mfsi::SceneConfig::load(
+      std::string(MFSI_CASES_DIR) + "/channel.yaml", mfsi::sceneSchema(),
+      {"fluid.probes=[{name: node, point: [3.0, 0.5, 0.05]}, {name: before, point: [2.95, 0.55, 0.05]},"
+       " {name: after, point: [3.05, 0.55, 0.05]}]"});
+  mfsi::Simulation sim(cfg);
+  const mfsi::RunResult r = sim.run(dir, false);
+  ASSERT_TRUE(r.steadyStateReached) << r.steadyStateMissed;
+  const auto steps = mfsi::test::readSteps(dir + "/steps.csv");
+  const double node = steps.at("fluid.probe.node").back(), before = steps.at("fluid.probe.before").back(),
+               after = steps.at("fluid.probe.after").back();
+  const double jump = before - after;  // dp/dx times one cell
+  ASSERT_GT(jump, 0.0);
+  EXPECT_NEAR(node, 0.5 * (before + after), 0.02 * jump);
+  EXPECT_GT(std::abs(node - before), 0.4 * jump);
+  EXPECT_GT(std::abs(node - after), 0.4 * jump);
+}
