@@ -431,23 +431,22 @@ struct DistributedAmg::Impl {
     denseRows(exec, coarseInv, coarseAll, L.x);
   }
 
+  /// Fourth-kind Chebyshev smoothing in D^-1 A on [0, lambda_max] (Lottes 2023, as kernels/Amg):
+  /// d_0 = 4 / (3 rho) D^-1 r_0, d_k = (2k - 1) / (2k + 3) d_{k-1} + (8k + 4) / ((2k + 3) rho) D^-1 r_k.
   void chebyshev(const ExecSpace& exec, Level& L) {
     const lid_t n = L.hA.nRows;
-    const double upper = L.lambdaMax, lower = upper / opt.chebyshevRatio;
-    const double theta = 0.5 * (upper + lower), delta = 0.5 * (upper - lower), sigma = theta / delta;
+    const double rho = L.lambdaMax;
     L.halo->exchange(exec, L.x);
     blas::spmv(exec, L.A, L.x, L.r);
     fromProduct(exec, n, L.b, L.r);
-    scaled(exec, n, 1.0 / theta, L.invDiag, L.r, L.d);
-    double rhoOld = 1.0 / sigma;
+    scaled(exec, n, 4.0 / (3.0 * rho), L.invDiag, L.r, L.d);
     for (int k = 1; k <= opt.chebyshevDegree; ++k) {
       blas::axpy(exec, n, 1.0, L.d, L.x);
       if (k == opt.chebyshevDegree) break;
       L.halo->exchange(exec, L.d);
       blas::spmv(exec, -1.0, L.A, L.d, 1.0, L.r);
-      const double rho = 1.0 / (2.0 * sigma - rhoOld);
-      chebyshevDirection(exec, n, rho * rhoOld, 2.0 * rho / delta, L.invDiag, L.r, L.d);
-      rhoOld = rho;
+      chebyshevDirection(exec, n, (2.0 * k - 1.0) / (2.0 * k + 3.0), (8.0 * k + 4.0) / ((2.0 * k + 3.0) * rho),
+                         L.invDiag, L.r, L.d);
     }
   }
 

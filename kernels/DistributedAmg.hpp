@@ -13,8 +13,8 @@
 ///  - each level has its own halo (the coarse ghosts a rank's rows and prolongator touch);
 ///  - once a level has at most `coarseSize` rows over all ranks it is gathered onto every rank
 ///    and solved by a dense pseudo-inverse (the same on every rank, so deterministic);
-///  - symmetric V-cycle with first-kind Chebyshev smoothing in D^{-1} A (lambda_max from power
-///    iterations), every product after a halo exchange; every sum in a fixed order.
+///  - symmetric V-cycle with fourth-kind Chebyshev smoothing in D^{-1} A (lambda_max from power
+///    iterations, boosted by 1.1), every product after a halo exchange; every sum in a fixed order.
 /// One rank is the same algorithm with no communication (the reference the distributed
 /// iteration counts are compared with). The serial kernels/Amg.hpp remains the one-rank solver of
 /// the fluid (lattice fast paths, float cycle); this one is simpler and double throughout.
@@ -31,9 +31,8 @@ namespace mfsi {
 
 struct DistributedAmgOptions {
   double strengthThreshold = 0.08;  ///< finest level; 0 below
-  double prolongationDamping = 4.0 / 3.0;
-  int chebyshevDegree = 2;
-  double chebyshevRatio = 30;       ///< smoothed interval [lambda_max / ratio, lambda_max]
+  double prolongationDamping = 1.45;  ///< omega lambda_max of the prolongator smoothing (kernels/Amg's)
+  int chebyshevDegree = 2;          ///< of the fourth-kind Chebyshev smoother
   std::int64_t coarseSize = 300;    ///< rows over all ranks at or below which a level is solved directly
   int maxLevels = 16;
 };
