@@ -197,7 +197,8 @@ LaplacianCgResult laplacianCg(const ExecSpace& exec, const SmoothingGraph& g, co
   double rz = s0[1];
   // The residual's round-off level: sum_j w_ij d_i is computed with relative errors of ~1e-16.
   const double floor = 1e-13 * std::sqrt(s0[2]);
-  const double target = std::max({options.absTol, options.relTol * res.initialResidual, floor});
+  const double scale = options.fieldScaled ? std::max(res.initialResidual, std::sqrt(s0[2])) : res.initialResidual;
+  const double target = std::max({options.absTol, options.relTol * scale, floor});
   if (!(res.initialResidual > target)) {
     res.converged = true;
     return res;

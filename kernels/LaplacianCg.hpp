@@ -31,6 +31,11 @@ enum class LaplacianPreconditioner { Jacobi, Amg };
 
 struct LaplacianCgOptions {
   double relTol = 1e-8;     ///< stop when ||r|| <= relTol ||r_0|| (r_0 of the warm start)
+  /// Also stop when ||r|| <= relTol ||D d_0|| (d_0 the warm start's free entries, D the diagonal):
+  /// a tolerance on the scale of the field, not of the warm start's residual, so that a good warm
+  /// start (the previous coupling iteration's motion) ends the solve early instead of reducing
+  /// an already small residual by relTol once more.
+  bool fieldScaled = false;
   double absTol = 0;        ///< or ||r|| <= absTol, or at round-off: ||r|| <= 1e-13 ||D d|| (D the diagonal)
   int maxIterations = 2000;
   LaplacianPreconditioner preconditioner = LaplacianPreconditioner::Jacobi;

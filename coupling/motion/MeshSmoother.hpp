@@ -37,7 +37,7 @@ struct MeshSmootherOptions {
   /// whose edge weights 1 / L^2 (L the reference edge length) make small cells move more rigidly.
   int retries = 3;
   MeshMotionMethod method = MeshMotionMethod::Jacobi;
-  double relTol = 1e-3;      ///< CG: residual reduction per motion (warm-started: 1e-2 to 1e-8 give the cavity the same peak to 1e-6)
+  double relTol = 1e-5;      ///< CG: residual per motion, relative to the larger of the warm start's residual and the field's scale
   int maxIterations = 2000;  ///< CG: iterations per motion
   /// CG: the preconditioner (Jacobi: O(N) cheap iterations; AMG: a few V-cycles per component).
   LaplacianPreconditioner preconditioner = LaplacianPreconditioner::Amg;

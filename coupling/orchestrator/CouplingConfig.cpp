@@ -14,7 +14,7 @@ Schema couplingSchema() {
                               {"cg", "jacobi"}),
                Default("cg"))
           .key("sweeps", Schema::integer("jacobi: sweeps per motion").atLeast(0), Default(o.motion.sweeps))
-          .key("relTol", Schema::real("cg: residual reduction per motion", "-").greaterThan(0).lessThan(1),
+          .key("relTol", Schema::real("cg: residual per motion, relative to the larger of the warm start's residual and the displacement field's scale", "-").greaterThan(0).lessThan(1),
                Default(o.motion.relTol))
           .key("maxIterations", Schema::integer("cg: iterations per motion").atLeast(1),
                Default(o.motion.maxIterations))
