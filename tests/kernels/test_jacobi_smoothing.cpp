@@ -235,6 +235,54 @@ TEST(LaplacianCg, SolvesWhatTheSweepsConvergeToOnAGradedMeshAndLeavesASolvedFiel
   EXPECT_EQ(maxDiff(zero, mfsi::Real3View("test::zeros", n)), 0.0);
 }
 
+TEST(LaplacianCg, AFieldScaledToleranceLetsAGoodWarmStartEndEarly) {
+  // The coupling's motions: the last solution, its boundary moved a little. Reducing the warm
+  // start's (small) residual by relTol costs as many iterations as a cold solve; a tolerance on
+  // the field's scale stops as soon as the residual is small against the field itself.
+  Graph b = boxGraph(8, {4, 1, 0.5});
+  const lid_t n = b.mesh.nNodes();
+  weightByInverseSquareLength(b);
+  mfsi::ExecSpace exec;
+  mfsi::LaplacianCgWork work;
+  mfsi::LaplacianCgOptions tight;
+  tight.relTol = 1e-13;
+  auto solved = boundaryOnly(b, rough);
+  mfsi::laplacianCg(exec, b.g, solved, work, tight);
+  // The next motion: every boundary value 0.1 % larger (the boundary of `rough` scaled).
+  auto exactNext = boundaryOnly(b, rough);
+  {
+    auto h = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), exactNext);
+    for (lid_t i = 0; i < n; ++i)
+      for (int c = 0; c < 3; ++c) h(i, c) *= 1.001;
+    Kokkos::deep_copy(exactNext, h);
+  }
+  auto warm = [&]() {
+    // Interior from the last solution, boundary from the next motion.
+    mfsi::Real3View w("test::warm", n);
+    auto hw = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), solved);
+    auto hb = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), exactNext);
+    auto fixed = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), b.g.fixed);
+    for (lid_t i = 0; i < n; ++i)
+      if (fixed(i) != 0)
+        for (int c = 0; c < 3; ++c) hw(i, c) = hb(i, c);
+    Kokkos::deep_copy(w, hw);
+    return w;
+  };
+  mfsi::laplacianCg(exec, b.g, exactNext, work, tight);
+  mfsi::LaplacianCgOptions reduce, scaled;
+  reduce.relTol = scaled.relTol = 1e-5;
+  scaled.fieldScaled = true;
+  auto byReduction = warm(), byScale = warm();
+  const auto rr = mfsi::laplacianCg(exec, b.g, byReduction, work, reduce);
+  const auto rs = mfsi::laplacianCg(exec, b.g, byScale, work, scaled);
+  EXPECT_TRUE(rs.converged);
+  EXPECT_LT(rs.iterations, rr.iterations / 2) << rs.iterations << " against " << rr.iterations;
+  // It still solves: the warm start's error (the 0.1 % boundary change not yet carried inside)
+  // falls tenfold, to the order of relTol times the grid's condition number (~ 8^2).
+  EXPECT_LT(maxDiff(byScale, exactNext), 0.1 * maxDiff(warm(), exactNext));
+  EXPECT_LT(maxDiff(byScale, exactNext), 1e-3);
+}
+
 TEST(LaplacianCg, TheAmgPreconditionerSolvesTheSameFieldInAFewIterationsWithSlidingNodes) {
   // A 16^3 box graded 8:1 with 1/L^2 weights; the nodes of the x = 0 face (not on other faces)
   // slide in that face. Jacobi-preconditioned and AMG-preconditioned CG must land on the same
