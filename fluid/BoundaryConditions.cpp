@@ -1,6 +1,7 @@
 #include "fluid/BoundaryConditions.hpp"
 
 #include "core/Error.hpp"
+#include "core/parallel/LocalMesh.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -64,7 +65,7 @@ real shapeAt(const ResolvedPatch& rp, const real x[3]) {
 
 }  // namespace
 
-BoundaryConditions::BoundaryConditions(const HexMesh& mesh, const FluidOptions& opt)
+BoundaryConditions::BoundaryConditions(const HexMesh& mesh, const FluidOptions& opt, const SolverComm& comm)
     : mesh_(&mesh), nIn_(mesh.nInternalFaces()) {
   const auto& mp = mesh.patches();
   std::vector<const PatchBC*> given(mp.size(), nullptr);
@@ -91,6 +92,10 @@ BoundaryConditions::BoundaryConditions(const HexMesh& mesh, const FluidOptions& 
     rp.start = mp[i].start;
     rp.size = mp[i].size;
     if (given[i]) rp.bc = *given[i];
+    // The faces of ghost cells that lead to cells of other ranks: no row of this rank reads
+    // them (the ghosts' values come from their owners), so they take the condition that reads
+    // nothing and adds nothing.
+    if (rp.name == kProcessorPatch && mp[i].kind == PatchKind::Patch) rp.bc.type = BoundaryType::Empty;
     if (rp.bc.type == BoundaryType::Auto) {
       switch (mp[i].kind) {
         case PatchKind::Wall:
@@ -129,6 +134,12 @@ BoundaryConditions::BoundaryConditions(const HexMesh& mesh, const FluidOptions& 
       MFSI_CHECK(tf.exponent > 0,
                  "fluid: patch '" << rp.name << "': half-power sine exponent must be positive, got " << tf.exponent);
     }
+    // A flow-rate inlet scales its profile by a sum over its faces, a resistance outlet its
+    // pressure by the flux summed over its faces: both sums would need the other ranks' faces.
+    MFSI_CHECK(mesh.nOwnedCells() == mesh.nCells() ||
+                   (rp.type != BoundaryType::FlowRate && rp.type != BoundaryType::Resistance),
+               "fluid: patch '" << rp.name << "': " << (rp.type == BoundaryType::FlowRate ? "flowRate" : "resistance")
+                                << " conditions do not run on several ranks yet");
     if (rp.type == BoundaryType::FixedPressure || rp.type == BoundaryType::Resistance) fixesPressure_ = true;
     // Bounding box of the patch nodes (reference configuration).
     rp.boxMin = {1e300, 1e300, 1e300};
@@ -139,6 +150,10 @@ BoundaryConditions::BoundaryConditions(const HexMesh& mesh, const FluidOptions& 
           rp.boxMin[d] = std::min(rp.boxMin[d], hPts(hFn(f, a), d));
           rp.boxMax[d] = std::max(rp.boxMax[d], hPts(hFn(f, a), d));
         }
+    for (int d = 0; d < 3; ++d) {
+      rp.boxMin[d] = -comm.globalMax(-rp.boxMin[d]);
+      rp.boxMax[d] = comm.globalMax(rp.boxMax[d]);
+    }
     patches_.push_back(rp);
   }
 

@@ -5,6 +5,7 @@
 #include "core/io/Checkpoint.hpp"
 #include "core/MeshGeometry.hpp"
 #include "fluid/FluidOptions.hpp"
+#include "kernels/Blas.hpp"
 
 #include <string>
 #include <vector>
@@ -41,7 +42,9 @@ class BoundaryConditions {
   BoundaryConditions() = default;
   /// \brief Resolve `opt.boundaries` against the patches of `mesh`. Throws InputError for unknown
   /// patch names, plain patches without a condition, and inconsistent options.
-  BoundaryConditions(const HexMesh& mesh, const FluidOptions& opt);
+  /// On a decomposed mesh `comm` spans the ranks: a patch's bounding box (the extent of its
+  /// profiles) is then that of all its faces, not this rank's.
+  BoundaryConditions(const HexMesh& mesh, const FluidOptions& opt, const SolverComm& comm = {});
 
   /// \brief Evaluate prescribed values at time t on the current geometry. `faceMeshVelocity`
   /// (per boundary face) feeds walls with `WallMotion::MeshVelocity`.

@@ -250,6 +250,14 @@ Schema fluidSchema() {
                           {"upwind", "linear", "limitedLinear", "vanLeer"}),
            Default("linear"))
       .key("gradient", Schema::choice("cell gradients", {"gaussLinear", "leastSquares"}), Default("gaussLinear"))
+      .key("nonOrthogonalLimit",
+           Schema::real("OpenFOAM's 'limited psi' face-normal gradients: each face's explicit non-orthogonal "
+                        "correction (pressure and viscous terms) is at most psi / (1 - psi) times its orthogonal "
+                        "part; 1 = corrected, 0 = uncorrected, 0.5 = OpenFOAM's usual choice for distorted meshes",
+                        "-")
+               .atLeast(0)
+               .atMost(1),
+           Default(d.nonOrthogonalLimit))
       .key("pimple", pimple, Presence::Optional)
       .key("solvers", solvers, Presence::Optional)
       .key("initial",
@@ -312,6 +320,7 @@ FluidOptions readFluidOptions(const SceneConfig& c, const HexMesh& mesh) {
                                          : ConvectionScheme::Linear;
   o.gradient =
       c.get<std::string>("gradient") == "leastSquares" ? GradientScheme::LeastSquares : GradientScheme::GaussLinear;
+  o.nonOrthogonalLimit = c.get<double>("nonOrthogonalLimit");
 
   o.pimple.nOuterCorrectors = c.get<int>("pimple.outerCorrectors");
   o.pimple.nCorrectors = c.get<int>("pimple.correctors");

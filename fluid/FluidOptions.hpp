@@ -187,6 +187,11 @@ struct FluidOptions {
   TimeScheme timeScheme = TimeScheme::BDF2;
   ConvectionScheme convection = ConvectionScheme::Linear;
   GradientScheme gradient = GradientScheme::GaussLinear;
+  /// OpenFOAM's `limited psi` surface-normal gradient: each face's explicit non-orthogonal
+  /// correction is at most psi / (1 - psi) times its orthogonal part (pressure equation, its face
+  /// fluxes and the viscous term). 1 = fully corrected, 0 = uncorrected, 0.5 = the correction at
+  /// most as large as the orthogonal part.
+  real nonOrthogonalLimit = 1.0;
   WallPressure wallPressure = WallPressure::Extrapolated;
   ReductionMode reduction = ReductionMode::Gather;
   /// Use the fused per-cell passes where valid: momentum matrix and source (orthogonal mesh, linear

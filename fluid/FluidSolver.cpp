@@ -2,6 +2,7 @@
 
 #include "core/Error.hpp"
 #include "fluid/MeshFlux.hpp"
+#include "kernels/DistributedAmg.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -114,6 +115,17 @@ KOKKOS_INLINE_FUNCTION real nonOrthogonalPart(lid_t f, lid_t o, lid_t n, real wf
   real corr = 0;
   for (int i = 0; i < 3; ++i) corr += kv(f, i) * (wf * gp(o, i) + (1.0 - wf) * gp(n, i));
   return corr;
+}
+
+/// The limit psi / (1 - psi) of OpenFOAM's `limited psi` scheme; negative when psi = 1 (no limit).
+inline real nonOrthogonalLimitFactor(real psi) { return psi >= 1.0 ? -1.0 : psi / (1.0 - psi); }
+
+/// The explicit correction `corr` of a face limited to `lim` times the orthogonal part `orth`
+/// (OpenFOAM's limiter corr * min(lim |orth| / |corr|, 1)); lim < 0: unlimited.
+KOKKOS_INLINE_FUNCTION real limitedCorrection(real corr, real orth, real lim) {
+  if (lim < 0) return corr;
+  const real m = lim * kmath::fabs(orth);
+  return corr > m ? m : (corr < -m ? -m : corr);
 }
 
 /// Pressure-equation coefficient of internal face f: the face-interpolated rAU over the distance.
@@ -278,6 +290,18 @@ lid_t countVelocityFromCells(const ExecSpace& exec, const ConstIndexView& kind, 
   return n;
 }
 
+/// The first `nRows` rows of A: the same arrays, the row pointer and diagonal cut (the solvers'
+/// view of a decomposed mesh's matrix, whose ghost rows are assembled but not solved for).
+CsrMatrix ownedRows(const CsrMatrix& A, lid_t nRows) {
+  CsrMatrix R = A;
+  R.nRows = nRows;
+  R.nCols = A.nCols;
+  R.rowPtr = Kokkos::subview(A.rowPtr, Kokkos::make_pair(lid_t(0), nRows + 1));
+  R.diagIdx = Kokkos::subview(A.diagIdx, Kokkos::make_pair(lid_t(0), nRows));
+  R.runs = CsrRowRuns{};
+  return R;
+}
+
 /// U = u0 in every cell.
 void fillVelocity(const ExecSpace& exec, const Real3View& U, const Vec3& u0) {
   const real u0x = u0[0], u0y = u0[1], u0z = u0[2];
@@ -291,14 +315,26 @@ void fillVelocity(const ExecSpace& exec, const Real3View& U, const Vec3& u0) {
 
 }  // namespace
 
-FluidSolver::FluidSolver(const HexMesh& mesh, const FluidOptions& options)
+FluidSolver::FluidSolver(const HexMesh& mesh, const FluidOptions& options, const RankDomain& domain)
     : mesh_(mesh),
       opt_(options),
       nCells_(mesh.nCells()),
       nFaces_(mesh.nFaces()),
       nIn_(mesh.nInternalFaces()),
-      nB_(mesh.nBoundaryFaces()) {
-  MFSI_CHECK(mesh.nOwnedCells() == mesh.nCells(), "fluid: the fluid solver runs on one rank (mesh has ghost cells)");
+      nB_(mesh.nBoundaryFaces()),
+      nRows_(mesh.nOwnedCells()) {
+  MFSI_CHECK(domain.distributed() || nRows_ == nCells_,
+             "fluid: the mesh has ghost cells but no ranks to take their values from");
+  if (domain.distributed()) {
+    MFSI_CHECK(domain.cells.nOwned == nRows_ && domain.cells.nLocal == nCells_,
+               "fluid: the halo plan (" << domain.cells.nOwned << " owned, " << domain.cells.nLocal
+                                        << " local cells) is not the mesh's (" << nRows_ << ", " << nCells_ << ")");
+    cellHalo_ = std::make_unique<Halo>(domain.comm, domain.cells);
+    comm_ = SolverComm(domain.comm, cellHalo_.get());
+    // The fused per-cell passes and CG's lattice are one-rank fast paths: the face-coefficient
+    // paths give the same fields.
+    opt_.fusedMomentumAssembly = false;
+  }
   MFSI_CHECK(opt_.density > 0, "fluid: density must be positive (key fluid.density)");
   MFSI_CHECK(opt_.viscosity >= 0, "fluid: viscosity must be non-negative (key fluid.viscosity)");
   MFSI_CHECK(opt_.pimple.nOuterCorrectors >= 1, "fluid: nOuterCorrectors must be >= 1");
@@ -308,8 +344,18 @@ FluidSolver::FluidSolver(const HexMesh& mesh, const FluidOptions& options)
   MFSI_CHECK(opt_.pimple.relaxPressure > 0 && opt_.pimple.relaxPressure <= 1, "fluid: relaxPressure must be in (0, 1]");
   MFSI_CHECK(!opt_.pimple.consistent || (opt_.timeScheme == TimeScheme::Steady && opt_.pimple.relaxVelocity < 1),
              "fluid: SIMPLEC (consistent) needs timeScheme steady and relaxVelocity < 1");
-  MFSI_CHECK(opt_.pressureReferenceCell >= 0 && opt_.pressureReferenceCell < nCells_,
-             "fluid: pressureReferenceCell " << opt_.pressureReferenceCell << " is not a cell of the mesh");
+  {
+    // The reference cell is a global id: found among the owned cells of whichever rank has it.
+    auto gid = Kokkos::create_mirror_view_and_copy(HostSpace(), mesh.cellGlobalIds());
+    lid_t found = 0;
+    for (lid_t c = 0; c < nRows_; ++c)
+      if (static_cast<long long>(gid(c)) == static_cast<long long>(opt_.pressureReferenceCell)) {
+        referenceRow_ = c;
+        found = 1;
+      }
+    MFSI_CHECK(comm_.globalSum(static_cast<double>(found)) == 1.0,
+               "fluid: pressureReferenceCell " << opt_.pressureReferenceCell << " is not a cell of the mesh");
+  }
   MFSI_CHECK(opt_.artificialCompressibility.soundSpeed >= 0,
              "fluid: artificialCompressibility.soundSpeed must be >= 0 (0: off), got "
                  << opt_.artificialCompressibility.soundSpeed);
@@ -321,11 +367,22 @@ FluidSolver::FluidSolver(const HexMesh& mesh, const FluidOptions& options)
   sparsity_ = buildSparsity(mesh);
   Au_ = makeMatrix(sparsity_, "mfsi::fluid::momentum::matrix");
   Ap_ = makeMatrix(sparsity_, "mfsi::fluid::pressure::matrix");
-  bc_ = BoundaryConditions(mesh, opt_);
+  bc_ = BoundaryConditions(mesh, opt_, comm_);
   boundaryCells_ = boundaryCells(mesh);
   for (const auto& rp : bc_.patches()) hasResistance_ = hasResistance_ || rp.type == BoundaryType::Resistance;
   boundaryVelocityReadsU_ = countVelocityFromCells(exec_, bc_.kind(), nB_) > 0;
   linear_ = LinearSolver(nCells_, opt_.pressurePreconditioner);
+  if (cellHalo_) {
+    AuRows_ = ownedRows(Au_, nRows_);
+    ApRows_ = ownedRows(Ap_, nRows_);
+    std::unique_ptr<Preconditioner> pressure;
+    if (opt_.pressurePreconditioner == PressurePreconditioner::Amg) {
+      auto gid = Kokkos::create_mirror_view_and_copy(HostSpace(), mesh.cellGlobalIds());
+      std::vector<gid_t> ids(gid.data(), gid.data() + nCells_);
+      pressure = std::make_unique<DistributedAmg>(domain.comm, domain.cells, std::move(ids));
+    }
+    linear_.distribute(comm_, std::move(pressure));
+  }
 
   U_ = Real3View("mfsi::fluid::U", nCells_);
   U0_ = Real3View("mfsi::fluid::U0", nCells_);
@@ -400,7 +457,9 @@ void FluidSolver::updateGeometry() {
       },
       Kokkos::Max<real>(kmax));
   // Round-off of a Cartesian mesh is ~1e-16; a face tilted by 1e-8 rad already counts.
-  nonOrthogonal_ = !(kmax <= 1e-12);
+  // A limit of 0 is the uncorrected scheme: the mesh is then treated as orthogonal.
+  kmax = comm_.globalMax(kmax);
+  nonOrthogonal_ = !(kmax <= 1e-12) && opt_.nonOrthogonalLimit > 0;
 }
 
 void FluidSolver::computeTimeCoefficients() {
@@ -593,7 +652,7 @@ void FluidSolver::loadState(const io::StateReader& r) {
   bc_.loadState(r.sub("boundaryConditions"));
   // The preconditioner's replay writes Ap_'s values: they are read back after it.
   pressureLattice_ = nullptr;
-  linear_.loadPressurePreconditioner(r.sub("pressurePreconditioner"), exec_, Ap_);
+  linear_.loadPressurePreconditioner(r.sub("pressurePreconditioner"), exec_, pressureMatrix());
   r.getView("pressureMatrix", Ap_.values);
   stepStart_.valid = false;
   exec_.fence();
@@ -784,6 +843,7 @@ void FluidSolver::updatePressureGradient() {
   if (gradPValid_) return;
   if (fusedCellPasses() && opt_.gradient == GradientScheme::GaussLinear) {
     pressureGradientFused();
+    exchangeGhosts(gradP_);
     gradPValid_ = true;
     return;
   }
@@ -798,6 +858,7 @@ void FluidSolver::updatePressureGradient() {
     updateBoundaryPressure();
     pressureGradient(boundaryCells_);
   }
+  exchangeGhosts(gradP_);
   gradPValid_ = true;
 }
 
@@ -834,6 +895,7 @@ void FluidSolver::computeVelocityGradient() const {
     cellGradient(exec_, mesh_, gradStencil_, U_, Ub_, gradU_);
   else
     cellGradient(exec_, opt_.gradient, mesh_, geo_, fd_, U_, Ub_, gradU_);
+  exchangeGhosts(gradU_);
 }
 
 ConstTensor3View FluidSolver::velocityGradient() const {
@@ -866,6 +928,7 @@ FluidSolver::MomentumAssembly FluidSolver::assembleMomentum(bool withB, bool wit
   }
   const lid_t nIn = nIn_;
   const bool nonOrth = nonOrthogonal_;
+  const real lim = nonOrthogonalLimitFactor(opt_.nonOrthogonalLimit);
   ConstIndexView own = mesh_.faceOwner(), nei = mesh_.faceNeighbour();
   ConstIndexView kind = bc_.kind();
   ConstRealView phi = phi_, mp = meshPhi_, w = fd_.weight, dc = fd_.deltaCoeff;
@@ -898,7 +961,7 @@ FluidSolver::MomentumAssembly FluidSolver::assembleMomentum(bool withB, bool wit
             if (nonOrth) {
               real corr = 0;
               for (int i = 0; i < 3; ++i) corr += kv(f, i) * (wf * G(o, i, j) + (1.0 - wf) * G(n, i, j));
-              fl = -mu * corr;
+              fl = -mu * limitedCorrection(corr, dc(f) * (U(n, j) - U(o, j)), lim);
             }
             if (limited) {
               // Deferred correction: implicit upwind plus F (phi_TVD - phi_upwind) lagged.
@@ -952,7 +1015,7 @@ FluidSolver::MomentumAssembly FluidSolver::assembleMomentum(bool withB, bool wit
   auto cd = cellDiag_;
   auto rhs = rhsU_;
   Kokkos::parallel_for(
-      "mfsi::fluid::momentum::cellTerms", RangePolicy(exec_, 0, nCells_), KOKKOS_LAMBDA(lid_t c) {
+      "mfsi::fluid::momentum::cellTerms", RangePolicy(exec_, 0, nRows_), KOKKOS_LAMBDA(lid_t c) {
         cd(c) = steady ? 0.0 : rho * c1 * V(c) * rdt;
         const real g[3] = {gx, gy, gz};
         for (int j = 0; j < 3; ++j) {
@@ -972,7 +1035,7 @@ FluidSolver::MomentumAssembly FluidSolver::assembleMomentum(bool withB, bool wit
   ConstIndexView rp = Au_.rowPtr;
   const RealView frac = relaxFraction_;
   Kokkos::parallel_for(
-      "mfsi::fluid::momentum::relax", RangePolicy(exec_, 0, nCells_), KOKKOS_LAMBDA(lid_t c) {
+      "mfsi::fluid::momentum::relax", RangePolicy(exec_, 0, nRows_), KOKKOS_LAMBDA(lid_t c) {
         const lid_t dk = di(c);
         const real a = vals(dk);
         real sumOff = 0;
@@ -983,6 +1046,7 @@ FluidSolver::MomentumAssembly FluidSolver::assembleMomentum(bool withB, bool wit
         if (frac.extent(0) > 0) frac(c) = ar != 0.0 ? 1.0 - a / ar : 0.0;
         for (int j = 0; j < 3; ++j) rhs(c, j) += (ar - a) * U(c, j);
       });
+  if (frac.extent(0) > 0) exchangeGhosts(frac);  // interpolated to the faces by PhiHbyAFace
   return {};
 }
 
@@ -1072,10 +1136,11 @@ void FluidSolver::assembleMomentumFused(bool withB, bool withInv) {
   // The relaxed diagonal is in a register here: its inverse costs a store, not invertDiagonal's
   // pass over the matrix (64^3 cavity, 1 thread: ~1 ms per step).
   if (withInv) k.inv = linear_.momentumInverseDiagonal(nCells_);
-  lid_t bad = nCells_;
-  Kokkos::parallel_reduce("mfsi::fluid::momentum::assembleFused", RangePolicy(exec_, 0, nCells_), k,
+  lid_t bad = nRows_;
+  Kokkos::parallel_reduce("mfsi::fluid::momentum::assembleFused", RangePolicy(exec_, 0, nRows_), k,
                           Kokkos::Min<lid_t>(bad));
-  MFSI_CHECK(bad >= nCells_, "linear solver: diagonal entry of row " << bad << " is missing, zero or not finite");
+  if (relaxFraction_.extent(0) > 0) exchangeGhosts(relaxFraction_);
+  MFSI_CHECK(bad >= nRows_, "linear solver: diagonal entry of row " << bad << " is missing, zero or not finite");
 }
 
 void FluidSolver::computeHbyA(bool withRAU) {
@@ -1096,7 +1161,7 @@ void FluidSolver::computeHbyA(bool withRAU) {
   auto rAUs = rAUSimple_;
   const real floorFactor = 0.5 * (1.0 - opt_.pimple.relaxVelocity);
   Kokkos::parallel_for(
-      "mfsi::fluid::momentum::HbyA", RangePolicy(exec_, 0, nCells_), KOKKOS_LAMBDA(lid_t c) {
+      "mfsi::fluid::momentum::HbyA", RangePolicy(exec_, 0, nRows_), KOKKOS_LAMBDA(lid_t c) {
         real h[3] = {rhs(c, 0), rhs(c, 1), rhs(c, 2)};
         real offSum = 0;
         const lid_t dk = di(c);
@@ -1116,6 +1181,10 @@ void FluidSolver::computeHbyA(bool withRAU) {
           rAU(c) = V(c) / diag;
         }
       });
+  // The faces interpolate both: the ghosts take their owners' rows.
+  exchangeGhosts(HbyA_);
+  if (withRAU) exchangeGhosts(rAU_);
+  if (simplec) exchangeGhosts(rAUSimple_);
 }
 
 void FluidSolver::simplecCorrection() {
@@ -1131,6 +1200,7 @@ void FluidSolver::simplecCorrection() {
   ConstRealView w = fd_.weight, dc = fd_.deltaCoeff, rAtU = rAU_, rAUs = rAUSimple_, p = p_, pb = pb_;
   ConstReal3View kv = fd_.nonOrth, gp = gradP_;
   const bool nonOrth = nonOrthogonal_;
+  const real lim = nonOrthogonalLimitFactor(opt_.nonOrthogonalLimit);
   auto phiH = phiHbyA_;
   Kokkos::parallel_for(
       "mfsi::fluid::pressure::simplecFlux", RangePolicy(exec_, 0, nFaces_), KOKKOS_LAMBDA(lid_t f) {
@@ -1139,7 +1209,8 @@ void FluidSolver::simplecCorrection() {
           const lid_t n = nei(f);
           const real wf = w(f);
           const real dr = wf * (rAtU(o) - rAUs(o)) + (1.0 - wf) * (rAtU(n) - rAUs(n));
-          const real sn = dc(f) * (p(n) - p(o)) + (nonOrth ? nonOrthogonalPart(f, o, n, wf, kv, gp) : 0.0);
+          const real orth = dc(f) * (p(n) - p(o));
+          const real sn = orth + (nonOrth ? limitedCorrection(nonOrthogonalPart(f, o, n, wf, kv, gp), orth, lim) : 0.0);
           phiH(f) += dr * sn;
         } else if (kind(f - nIn) == kFacePressure) {
           phiH(f) += (rAtU(o) - rAUs(o)) * dc(f) * (pb(f - nIn) - p(o));
@@ -1234,7 +1305,8 @@ void FluidSolver::computePhiHbyA() {
 void FluidSolver::pinPressureLevel() {
   // No boundary sets the level: doubling one diagonal entry (and adding the matching source in
   // finishPressureSource) pins p at the reference cell without changing the other equations.
-  const lid_t ref = opt_.pressureReferenceCell;
+  if (referenceRow_ < 0) return;  // another rank's cell
+  const lid_t ref = referenceRow_;
   ConstIndexView di = Ap_.diagIdx;
   auto vals = Ap_.values;
   RealView d = pressureLattice_ != nullptr ? pressureLattice_->diagonal() : RealView();
@@ -1313,7 +1385,7 @@ void FluidSolver::assemblePressureMatrixFused(bool stored) {
   auto vals = Ap_.values;
   auto rhs = rhsP_;
   Kokkos::parallel_for(
-      "mfsi::fluid::pressure::assembleFused", RangePolicy(exec_, 0, nCells_), KOKKOS_LAMBDA(lid_t cell) {
+      "mfsi::fluid::pressure::assembleFused", RangePolicy(exec_, 0, nRows_), KOKKOS_LAMBDA(lid_t cell) {
         for (lid_t e = rowPtr(cell); e < rowPtr(cell + 1); ++e) vals(e) = 0.0;
         real diag, div;
         row(cell, diag, div, [&](lid_t e, lid_t, real a) { vals(cfp(e)) += a; });
@@ -1333,7 +1405,7 @@ void FluidSolver::assemblePressureLatticeFused(SymmetricLatticeMatrix& lattice, 
   const RealView d = lattice.diagonal(), ux = lattice.upperX(), uy = lattice.upperY(), uz = lattice.upperZ();
   auto rhs = rhsP_;
   Kokkos::parallel_for(
-      "mfsi::fluid::pressure::assembleLattice", RangePolicy(exec_, 0, nCells_), KOKKOS_LAMBDA(lid_t cell) {
+      "mfsi::fluid::pressure::assembleLattice", RangePolicy(exec_, 0, nRows_), KOKKOS_LAMBDA(lid_t cell) {
         real diag, div, cx = 0.0, cy = 0.0, cz = 0.0;
         row(cell, diag, div, [&](lid_t, lid_t n, real a) {
           if (n == cell + 1)
@@ -1381,7 +1453,7 @@ void FluidSolver::assemblePressureMatrixFaces() {
     ConstRealView V = geo_.cellVolume;
     auto cd = cellDiag_;
     Kokkos::parallel_for(
-        "mfsi::fluid::pressure::compressibilityDiag", RangePolicy(exec_, 0, nCells_),
+        "mfsi::fluid::pressure::compressibilityDiag", RangePolicy(exec_, 0, nRows_),
         KOKKOS_LAMBDA(lid_t c) { cd(c) = k * c1 * V(c); });
   } else {
     Kokkos::deep_copy(exec_, cellDiag_, 0.0);
@@ -1466,6 +1538,8 @@ void FluidSolver::pressureSourceFluxFaces() {
   ConstRealView w = fd_.weight, dc = fd_.deltaCoeff, rAU = rAU_, phiH = phiHbyA_, pb = pb_;
   ConstReal3View kv = fd_.nonOrth, gp = gradP_;
   const bool nonOrth = nonOrthogonal_;
+  const real lim = nonOrthogonalLimitFactor(opt_.nonOrthogonalLimit);
+  ConstRealView p = p_;
   auto flux = fluxP_;
   Kokkos::parallel_for(
       "mfsi::fluid::pressure::sourceFlux", RangePolicy(exec_, 0, nFaces_), KOKKOS_LAMBDA(lid_t f) {
@@ -1476,7 +1550,7 @@ void FluidSolver::pressureSourceFluxFaces() {
             const lid_t n = nei(f);
             const real wf = w(f);
             const real rAUf = wf * rAU(o) + (1.0 - wf) * rAU(n);
-            fl -= rAUf * nonOrthogonalPart(f, o, n, wf, kv, gp);
+            fl -= rAUf * limitedCorrection(nonOrthogonalPart(f, o, n, wf, kv, gp), dc(f) * (p(n) - p(o)), lim);
           }
           flux(f) = fl;
         } else if (kind(f - nIn) == kFacePressure) {
@@ -1495,12 +1569,12 @@ void FluidSolver::finishPressureSource() {
     ConstRealView V0 = V0_, V00 = V00_, p0 = p0_, p00 = p00_;
     auto rhs = rhsP_;
     Kokkos::parallel_for(
-        "mfsi::fluid::pressure::compressibilitySource", RangePolicy(exec_, 0, nCells_),
+        "mfsi::fluid::pressure::compressibilitySource", RangePolicy(exec_, 0, nRows_),
         KOKKOS_LAMBDA(lid_t c) { rhs(c) += k * (c0 * V0(c) * p0(c) - c00 * V00(c) * p00(c)); });
   }
-  if (pinsPressureLevel()) {
+  if (pinsPressureLevel() && referenceRow_ >= 0) {
     // The reference row's diagonal was doubled from a: its source gets a pRef (a = half of it).
-    const lid_t ref = opt_.pressureReferenceCell;
+    const lid_t ref = referenceRow_;
     const real pRef = opt_.pressureReferenceValue;
     ConstIndexView di = Ap_.diagIdx;
     ConstRealView vals = Ap_.values;
@@ -1568,7 +1642,7 @@ real FluidSolver::continuityMax(real& sum) {
   real mx = 0;
   sum = 0;
   Kokkos::parallel_reduce(
-      "mfsi::fluid::continuity", RangePolicy(exec_, 0, nCells_),
+      "mfsi::fluid::continuity", RangePolicy(exec_, 0, nRows_),
       KOKKOS_LAMBDA(lid_t c, real & m, real & s) {
         const real a = kmath::fabs(div(c));
         const real r = a / V(c);
@@ -1576,7 +1650,8 @@ real FluidSolver::continuityMax(real& sum) {
         s += a;
       },
       Kokkos::Max<real>(mx), sum);
-  return mx;
+  sum = comm_.globalSum(sum);
+  return comm_.globalMax(mx);
 }
 
 void FluidSolver::fluxAndDdtCorrection() {
@@ -1636,7 +1711,7 @@ real FluidSolver::finishStep(real& sum, bool& finite, bool ddtStored) {
   real mx = 0, fin = 0;
   sum = 0;
   Kokkos::parallel_reduce(
-      "mfsi::fluid::finishStep", RangePolicy(exec_, 0, nCells_),
+      "mfsi::fluid::finishStep", RangePolicy(exec_, 0, nRows_),
       KOKKOS_LAMBDA(lid_t c, real & m, real & s, real & acc) {
         real div = 0;
         for (lid_t e = off(c); e < off(c + 1); ++e) {
@@ -1653,8 +1728,9 @@ real FluidSolver::finishStep(real& sum, bool& finite, bool ddtStored) {
       },
       Kokkos::Max<real>(mx), sum, fin);
   dphiLatest_ = true;
-  finite = std::isfinite(fin);
-  return mx;
+  finite = std::isfinite(comm_.globalSum(fin));
+  sum = comm_.globalSum(sum);
+  return comm_.globalMax(mx);
 }
 
 bool FluidSolver::fieldsFinite() {
@@ -1662,9 +1738,9 @@ bool FluidSolver::fieldsFinite() {
   ConstRealView p = p_;
   real s = 0;
   Kokkos::parallel_reduce(
-      "mfsi::fluid::finiteCheck", RangePolicy(exec_, 0, nCells_),
+      "mfsi::fluid::finiteCheck", RangePolicy(exec_, 0, nRows_),
       KOKKOS_LAMBDA(lid_t c, real & acc) { acc += fieldMagnitude(c, U, p); }, s);
-  return std::isfinite(s);
+  return std::isfinite(comm_.globalSum(s));
 }
 
 // ------------------------------------------------------------------------------------------------
@@ -1697,7 +1773,7 @@ void FluidSolver::startFinalPressureSolve() {
   // equal in size: cavity 64^3, s rises from 0.6 to 0.92 over steps 2-20, and the final solves
   // take 6.53 instead of 7.27 iterations per step (s = 1).
   real s = dpFinalValid_ ? 1.0 : 0.0;
-  if (dpFinalValid_ && opt_.pimple.projectFinalGuess) s = linear_.pressureStepAlong(exec_, Ap_, rhsP_, p_, dpFinal_);
+  if (dpFinalValid_ && opt_.pimple.projectFinalGuess) s = linear_.pressureStepAlong(exec_, pressureMatrix(), rhsP_, p_, dpFinal_);
   auto p = p_, start = pFinalStart_;
   ConstRealView dp = dpFinal_;
   Kokkos::parallel_for(
@@ -1740,20 +1816,21 @@ StepResult FluidSolver::solve() {
     real momRes = 0;
     if (pim.momentumPredictor) {
       ScopedRegion r2("mfsi::fluid::momentum::solve");
-      linear_.momentumMatrixChanged(exec_, Au_, formed.inv ? InverseDiagonal::Given : InverseDiagonal::Compute);
+      linear_.momentumMatrixChanged(exec_, momentumMatrix(),
+                                    formed.inv ? InverseDiagonal::Given : InverseDiagonal::Compute);
       // The three components share the matrix: one solve reads it once for all of them, each
       // component stopping on its own scaled residual.
       if (!bReady) {
         auto b3 = b3_;
         ConstReal3View rhs = rhsU_, gp = gradP_;
         Kokkos::parallel_for(
-            "mfsi::fluid::momentum::rhs", RangePolicy(exec_, 0, nCells_), KOKKOS_LAMBDA(lid_t c) {
+            "mfsi::fluid::momentum::rhs", RangePolicy(exec_, 0, nRows_), KOKKOS_LAMBDA(lid_t c) {
               for (int j = 0; j < 3; ++j) b3(c, j) = rhs(c, j) - V(c) * gp(c, j);
             });
       }
       // U is read by nothing between here and the solve: the guess changes where it starts only.
       if (freshStep_ && outer == 0 && extrapolatesVelocity() && nSteps_ >= 2) extrapolateVelocity();
-      for (const auto& st : linear_.solveMomentum3(exec_, Au_, b3_, U_, opt_.momentumSolver)) {
+      for (const auto& st : linear_.solveMomentum3(exec_, momentumMatrix(), b3_, U_, opt_.momentumSolver)) {
         momRes = std::max(momRes, st.initialResidual);
         res.momentumIterations += st.iterations;
         if (st.breakdown) res.ok = false;
@@ -1772,14 +1849,14 @@ StepResult FluidSolver::solve() {
       for (int no = 0; no <= pim.nNonOrthogonalCorrectors; ++no) {
         updatePressureGradient();
         assemblePressure(/*matrix=*/corr == 0 && no == 0);
-        if (corr == 0 && no == 0 && pressureLattice_ == nullptr) linear_.pressureValuesChanged(exec_, Ap_);
+        if (corr == 0 && no == 0 && pressureLattice_ == nullptr) linear_.pressureValuesChanged(exec_, pressureMatrix());
         ScopedRegion r3("mfsi::fluid::pressure::solve");
         // rAU, hence the matrix, is the same for every corrector of one outer iteration.
         const int refresh = opt_.pressurePreconditioner == PressurePreconditioner::Jacobi
                                 ? 1
                                 : std::max(1, opt_.pressurePreconditionerRefresh);
         if (corr == 0 && no == 0 && (pressureAssemblies_++ % refresh == 0 || pressureRefreshDue_)) {
-          linear_.pressureMatrixChanged(exec_, Ap_);
+          linear_.pressureMatrixChanged(exec_, pressureMatrix());
           pressureAssemblies_ = 1;
           refreshBaselineIterations_ = -1;
           pressureRefreshDue_ = false;
@@ -1795,7 +1872,7 @@ StepResult FluidSolver::solve() {
         // initial residual, one iteration fewer).
         const bool guessP = finalSolve && pim.extrapolateGuess && opt_.timeScheme != TimeScheme::Steady;
         if (guessP) startFinalPressureSolve();
-        const auto st = linear_.solvePressure(exec_, Ap_, rhsP_, p_, ps);
+        const auto st = linear_.solvePressure(exec_, pressureMatrix(), rhsP_, p_, ps);
         if (guessP) finishFinalPressureSolve();
         gradPValid_ = false;
         if (finalSolve && refresh > 1) {
@@ -1859,6 +1936,18 @@ StepResult FluidSolver::solveStep(real t, real dt) {
     moveMesh(pts);
   }
   return solve();
+}
+
+void FluidSolver::exchangeGhosts(const RealView& x) const {
+  if (cellHalo_) cellHalo_->exchange(exec_, x);
+}
+
+void FluidSolver::exchangeGhosts(const Real3View& x) const {
+  if (cellHalo_) cellHalo_->exchange(exec_, x);
+}
+
+void FluidSolver::exchangeGhosts(const Tensor3View& x) const {
+  if (cellHalo_) cellHalo_->exchange(exec_, x);
 }
 
 }  // namespace mfsi::fluid

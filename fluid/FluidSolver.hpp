@@ -25,6 +25,7 @@
 ///   }
 /// \endcode
 #include "core/MeshGeometry.hpp"
+#include "core/parallel/Halo.hpp"
 #include "fluid/BoundaryConditions.hpp"
 #include "fluid/FluidOptions.hpp"
 #include "fluid/FvAssembly.hpp"
@@ -33,6 +34,7 @@
 #include "fluid/LinearSolve.hpp"
 
 #include <functional>
+#include <memory>
 #include <string>
 
 namespace mfsi::fluid {
@@ -68,7 +70,11 @@ class FluidSolver {
  public:
   /// \brief Allocate fields, resolve boundary conditions and build the matrix sparsity.
   /// `mesh` must outlive the solver; the solver moves its points in `moveMesh`.
-  FluidSolver(const HexMesh& mesh, const FluidOptions& options);
+  /// On one rank's part of a decomposed mesh (core/parallel/LocalMesh), `domain` names the
+  /// other ranks: the solver then owns the rows of its owned cells, keeps its ghost cells' values
+  /// those of their owners (halo exchanges after every field a face reads is formed), sums over
+  /// ranks and solves the pressure with the distributed AMG (kernels/DistributedAmg).
+  FluidSolver(const HexMesh& mesh, const FluidOptions& options, const RankDomain& domain = {});
 
   // --- time stepping -------------------------------------------------------------------------
   /// \brief Start the step from t to t + dt: the current solution and geometry become the old time
@@ -138,6 +144,10 @@ class FluidSolver {
   /// Start time of the current step and its size.
   real time() const { return t_; }
   real timeStep() const { return dt_; }
+  /// Cells whose rows this solver owns (all of them on one rank; then the ghosts follow).
+  lid_t ownedCells() const { return nRows_; }
+  /// The ranks' sums and ghost exchanges (no-ops on one rank).
+  const SolverComm& comm() const { return comm_; }
   /// Number of `beginStep` calls so far.
   int stepIndex() const { return nSteps_; }
 
@@ -214,17 +224,33 @@ class FluidSolver {
   /// The fused end-of-step pass (storeDdtCorrection unless `ddtStored`, continuity, finiteness).
   real finishStep(real& sum, bool& finite, bool ddtStored);
   bool fieldsFinite();
+  /// Ghost entries <- their owners' values (no-op on one rank).
+  void exchangeGhosts(const RealView& x) const;
+  void exchangeGhosts(const Real3View& x) const;
+  void exchangeGhosts(const Tensor3View& x) const;
+  /// The momentum and pressure matrices as the linear solvers see them: the owned rows.
+  const CsrMatrix& momentumMatrix() const { return cellHalo_ ? AuRows_ : Au_; }
+  const CsrMatrix& pressureMatrix() const { return cellHalo_ ? ApRows_ : Ap_; }
 
  private:
   const HexMesh& mesh_;
   FluidOptions opt_;
   ExecSpace exec_;
   lid_t nCells_ = 0, nFaces_ = 0, nIn_ = 0, nB_ = 0;
+  /// Owned cells: the rows of the matrices and of every reduction; cells [nRows_, nCells_) are
+  /// ghosts whose values arrive from their owners through cellHalo_ (null on one rank).
+  lid_t nRows_ = 0;
+  std::unique_ptr<Halo> cellHalo_;
+  SolverComm comm_;
+  /// Local row of the pressure reference cell (pressureReferenceCell, a global id), -1 when another
+  /// rank owns it.
+  lid_t referenceRow_ = -1;
 
   MeshGeometry geo_;
   FvFaceData fd_;
   FvSparsity sparsity_;
   CsrMatrix Au_, Ap_;
+  CsrMatrix AuRows_, ApRows_;  ///< their owned rows (shared arrays), on a decomposed mesh
   FaceCoefficients fcU_, fcP_;  ///< allocated on first use (the fused paths do not need them)
   BoundaryConditions bc_;
   LinearSolver linear_;

@@ -22,8 +22,11 @@ class SharedJacobi final : public Preconditioner {
   void setup(const ExecSpace& exec, const CsrMatrix& A) override { invertDiagonal(exec, A, inv_); }
   void apply(const ExecSpace& exec, const ConstRealView& r, const RealView& z) override {
     const ConstRealView inv = inv_;
+    // The inverse diagonal may reach into the ghosts (BiCGStab3 reads it at neighbours): the rows
+    // are those of r.
+    const lid_t n = static_cast<lid_t>(std::min(inv.extent(0), r.extent(0)));
     Kokkos::parallel_for(
-        "mfsi::fluid::linear::jacobi", RangePolicy(exec, 0, static_cast<lid_t>(inv.extent(0))),
+        "mfsi::fluid::linear::jacobi", RangePolicy(exec, 0, n),
         KOKKOS_LAMBDA(lid_t i) { z(i) = inv(i) * r(i); });
   }
   std::string name() const override { return "jacobi"; }
@@ -57,6 +60,15 @@ LinearSolver::LinearSolver(lid_t n, PressurePreconditioner pp)
     pPrec_ = std::make_unique<JacobiPreconditioner>();
 }
 
+void LinearSolver::distribute(const SolverComm& comm, std::unique_ptr<Preconditioner> pressure) {
+  comm_ = comm;
+  uSolver_ = makeKrylovSolver(KrylovMethod::BiCGStab, {}, comm_);
+  pSolver_ = std::make_unique<ConjugateGradient>(KrylovOptions{}, comm_);
+  u3Solver_ = BiCGStab3({}, comm_);
+  if (pressure) pPrec_ = std::move(pressure);
+  uReady_ = pReady_ = false;
+}
+
 RealView LinearSolver::momentumInverseDiagonal(lid_t n) {
   if (uInvDiag_.extent(0) != static_cast<std::size_t>(n) || !uPrec_) {
     uInvDiag_ = RealView(Kokkos::view_alloc(Kokkos::WithoutInitializing, "mfsi::fluid::linear::momentumInvDiag"), n);
@@ -66,11 +78,15 @@ RealView LinearSolver::momentumInverseDiagonal(lid_t n) {
 }
 
 void LinearSolver::momentumMatrixChanged(const ExecSpace& exec, const CsrMatrix& A, InverseDiagonal inverse) {
+  // BiCGStab3 reads the inverse diagonal at the neighbours of a row: on a decomposed mesh it has
+  // the ghosts' entries too, from their owners.
+  const lid_t nc = std::max(A.nRows, A.nCols);
   if (inverse == InverseDiagonal::Given)
-    MFSI_CHECK(uInvDiag_.extent(0) == static_cast<std::size_t>(A.nRows) && uPrec_,
+    MFSI_CHECK(uInvDiag_.extent(0) == static_cast<std::size_t>(nc) && uPrec_,
                "LinearSolver::momentumMatrixChanged: no inverse diagonal was given");
   else
-    invertDiagonal(exec, A, momentumInverseDiagonal(A.nRows));
+    invertDiagonal(exec, A, momentumInverseDiagonal(nc));
+  comm_.updateGhosts(exec, uInvDiag_);
   uReady_ = true;
 }
 
@@ -128,6 +144,8 @@ void LinearSolver::loadPressurePreconditioner(const io::StateReader& r, const Ex
 }
 
 void LinearSolver::pressureValuesChanged(const ExecSpace& exec, const CsrMatrix& A) {
+  // CG's lattice copy is a one-rank fast path (a rank's rows with ghost columns are no lattice).
+  if (comm_.ranks() > 1) return;
   pSolver_->matrixChanged(exec, A);
 }
 
@@ -156,7 +174,7 @@ LinearSolveStats LinearSolver::solvePressure(const ExecSpace& exec, const CsrMat
 real LinearSolver::pressureStepAlong(const ExecSpace& exec, const CsrMatrix& A, const ConstRealView& b,
                                      const ConstRealView& x, const ConstRealView& d) {
   const lid_t n = A.nRows;
-  const SolverComm comm;
+  const SolverComm& comm = comm_;
   std::array<double, 3> s{};  // {d.b, (A d).x, d.(A d)}
   if (const SymmetricLatticeMatrix* L = pSolver_->latticeCopy(A)) {
     // The lattice product into the residual work array (free until the next solve), then the dots.
@@ -189,8 +207,9 @@ LinearSolveStats LinearSolver::solve(const ExecSpace& exec, KrylovSolver& solver
                                      const ConstRealView& b, const RealView& x, const LinearSolverOptions& o) {
   LinearSolveStats st;
   const lid_t n = A.nRows;
-  const SolverComm comm;
+  const SolverComm& comm = comm_;
   if (r_.extent(0) < static_cast<std::size_t>(n)) r_ = RealView("mfsi::fluid::linear::residual", n);
+  comm.updateGhosts(exec, x);
   // Two passes: the mean of x, then r = b - A x with the sums {|r|_1, normalisation factor,
   // round-off scale, r.r}; r and its norms are the Krylov solver's starting residual.
   const real xbar = blas::mean(exec, comm, n, x);
@@ -230,6 +249,7 @@ LinearSolveStats LinearSolver::solve(const ExecSpace& exec, KrylovSolver& solver
   r0.rr = s[3];
   r0.l1 = r1;
   const KrylovResult kr = solver.solve(exec, A, b, x, M, r0);
+  comm.updateGhosts(exec, x);  // the solver updates the owned rows: the ghosts follow their owners
   st.iterations = kr.iterations;
   st.converged = kr.converged;
   st.breakdown = kr.status == KrylovStatus::NotFinite || kr.status == KrylovStatus::Breakdown;
@@ -244,8 +264,9 @@ std::array<LinearSolveStats, 3> LinearSolver::solveMomentum3(const ExecSpace& ex
   MFSI_CHECK(uReady_, "LinearSolver::solveMomentum3: momentumMatrixChanged was not called");
   const lid_t n = A.nRows;
   const lid_t nc = std::max(A.nRows, A.nCols);  // BiCGStab3 gathers its residual at neighbours
-  const SolverComm comm;
+  const SolverComm& comm = comm_;
   if (r3_.extent(0) != static_cast<std::size_t>(nc)) r3_ = Real3View("mfsi::fluid::linear::residual3", nc);
+  comm.updateGhosts(exec, x);
   // The three means of x in one reduction, then one pass over A for the three columns: the row
   // sum (for A xbar) is shared, and per column the sums {|r|_1, normalisation factor, round-off
   // scale, r.r} - 12 sums in one deterministic reduction.
@@ -306,6 +327,7 @@ std::array<LinearSolveStats, 3> LinearSolver::solveMomentum3(const ExecSpace& ex
   }
   u3Solver_.setOptions(ko);
   const auto kr = u3Solver_.solve(exec, A, b, x, uInvDiag_, r0);
+  comm.updateGhosts(exec, x);
   for (int c = 0; c < 3; ++c) {
     if (st[c].breakdown) continue;
     st[c].iterations = kr[c].iterations;

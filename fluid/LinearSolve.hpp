@@ -49,6 +49,10 @@ class LinearSolver {
   LinearSolver(LinearSolver&&) noexcept;
   LinearSolver& operator=(LinearSolver&&) noexcept;
 
+  /// \brief Solve over ranks: every sum through `comm`, ghost entries of x refreshed through it
+  /// before a product; `pressure` replaces the pressure preconditioner (one that works across
+  /// ranks). Matrices are then the owned rows of a decomposed mesh (columns: owned, then ghosts).
+  void distribute(const SolverComm& comm, std::unique_ptr<Preconditioner> pressure);
   /// \brief The momentum matrix got new values (same sparsity): refresh its preconditioner.
   void momentumMatrixChanged(const ExecSpace& exec, const CsrMatrix& A,
                              InverseDiagonal inverse = InverseDiagonal::Compute);
@@ -101,6 +105,7 @@ class LinearSolver {
 
  private:
 
+  SolverComm comm_;
   std::unique_ptr<Preconditioner> uPrec_, pPrec_;
   std::unique_ptr<KrylovSolver> uSolver_;
   std::unique_ptr<ConjugateGradient> pSolver_;

@@ -27,8 +27,8 @@ Halo::Halo(MPI_Comm comm, const HaloPlan& plan)
     for (lid_t i = 0; i < nSend; ++i) h(i) = plan.sendIndices[i];
     Kokkos::deep_copy(sendIndices_, h);
   }
-  sendBuf_ = RealView("mfsi::core::halo::sendBuffer", 3 * static_cast<std::size_t>(nSend));
-  recvBuf_ = RealView("mfsi::core::halo::recvBuffer", 3 * static_cast<std::size_t>(nRecv));
+  sendBuf_ = RealView("mfsi::core::halo::sendBuffer", 9 * static_cast<std::size_t>(nSend));
+  recvBuf_ = RealView("mfsi::core::halo::recvBuffer", 9 * static_cast<std::size_t>(nRecv));
   sendHost_ = Kokkos::create_mirror_view(sendBuf_);
   recvHost_ = Kokkos::create_mirror_view(recvBuf_);
 }
@@ -53,8 +53,12 @@ int Halo::sendMessages() const {
   return n;
 }
 
+namespace {
+int requestSet(int components) { return components == 1 ? 0 : components == 3 ? 1 : 2; }
+}  // namespace
+
 void Halo::start(int components) const {
-  auto& reqs = requests_[components == 1 ? 0 : 1];
+  auto& reqs = requests_[requestSet(components)];
   if (reqs.empty()) {
     // Persistent requests on the (fixed) host buffers; a column count picks the message length.
     for (std::size_t k = 0; k < neighbours_.size(); ++k) {
@@ -77,30 +81,29 @@ void Halo::start(int components) const {
 }
 
 void Halo::finish(int components) const {
-  auto& reqs = requests_[components == 1 ? 0 : 1];
+  auto& reqs = requests_[requestSet(components)];
   if (!reqs.empty()) MPI_Waitall(static_cast<int>(reqs.size()), reqs.data(), MPI_STATUSES_IGNORE);
 }
 
-void Halo::exchange(const ExecSpace& exec, const RealView& x) const {
-  if (neighbours_.empty()) return;
-  MFSI_CHECK(static_cast<lid_t>(x.extent(0)) >= nLocal_,
-             "halo: field '" << x.label() << "' has " << x.extent(0) << " entries, the halo " << nLocal_);
-  const lid_t nSend = sendOffsets_.back(), nRecv = recvOffsets_.back(), base = nOwned_;
-  auto idx = sendIndices_;
-  auto buf = sendBuf_;
-  Kokkos::parallel_for("mfsi::core::halo::pack1", RangePolicy(exec, 0, nSend),
-                       KOKKOS_LAMBDA(lid_t i) { buf(i) = x(idx(i)); });
+void Halo::transfer(const ExecSpace& exec, int components) const {
   Kokkos::deep_copy(exec, sendHost_, sendBuf_);
   exec.fence();
-  start(1);
-  finish(1);
+  start(components);
+  finish(components);
   Kokkos::deep_copy(exec, recvBuf_, recvHost_);
-  auto rb = recvBuf_;
-  Kokkos::parallel_for("mfsi::core::halo::unpack1", RangePolicy(exec, 0, nRecv),
-                       KOKKOS_LAMBDA(lid_t i) { x(base + i) = rb(i); });
 }
 
-void Halo::exchange(const ExecSpace& exec, const Real3View& x) const {
+namespace {
+// Entry k of row i of a field with K columns, for the pack and unpack kernels.
+KOKKOS_INLINE_FUNCTION real& entry(const RealView& x, lid_t i, int) { return x(i); }
+KOKKOS_INLINE_FUNCTION real& entry(const Real3View& x, lid_t i, int k) { return x(i, k); }
+KOKKOS_INLINE_FUNCTION real& entry(const Kokkos::View<real* [3][3], MemSpace>& x, lid_t i, int k) {
+  return x(i, k / 3, k % 3);
+}
+}  // namespace
+
+template <int K, class View>
+void Halo::exchangeColumns(const ExecSpace& exec, const View& x) const {
   if (neighbours_.empty()) return;
   MFSI_CHECK(static_cast<lid_t>(x.extent(0)) >= nLocal_,
              "halo: field '" << x.label() << "' has " << x.extent(0) << " entries, the halo " << nLocal_);
@@ -108,19 +111,23 @@ void Halo::exchange(const ExecSpace& exec, const Real3View& x) const {
   auto idx = sendIndices_;
   auto buf = sendBuf_;
   Kokkos::parallel_for(
-      "mfsi::core::halo::pack3", RangePolicy(exec, 0, nSend), KOKKOS_LAMBDA(lid_t i) {
-        for (int k = 0; k < 3; ++k) buf(3 * i + k) = x(idx(i), k);
+      "mfsi::core::halo::pack", RangePolicy(exec, 0, nSend), KOKKOS_LAMBDA(lid_t i) {
+        for (int k = 0; k < K; ++k) buf(K * i + k) = entry(x, idx(i), k);
       });
-  Kokkos::deep_copy(exec, sendHost_, sendBuf_);
-  exec.fence();
-  start(3);
-  finish(3);
-  Kokkos::deep_copy(exec, recvBuf_, recvHost_);
+  transfer(exec, K);
   auto rb = recvBuf_;
   Kokkos::parallel_for(
-      "mfsi::core::halo::unpack3", RangePolicy(exec, 0, nRecv), KOKKOS_LAMBDA(lid_t i) {
-        for (int k = 0; k < 3; ++k) x(base + i, k) = rb(3 * i + k);
+      "mfsi::core::halo::unpack", RangePolicy(exec, 0, nRecv), KOKKOS_LAMBDA(lid_t i) {
+        for (int k = 0; k < K; ++k) entry(x, base + i, k) = rb(K * i + k);
       });
+}
+
+void Halo::exchange(const ExecSpace& exec, const RealView& x) const { exchangeColumns<1>(exec, x); }
+
+void Halo::exchange(const ExecSpace& exec, const Real3View& x) const { exchangeColumns<3>(exec, x); }
+
+void Halo::exchange(const ExecSpace& exec, const Kokkos::View<real* [3][3], MemSpace>& x) const {
+  exchangeColumns<9>(exec, x);
 }
 
 }  // namespace mfsi

@@ -18,6 +18,16 @@
 
 namespace mfsi {
 
+/// \brief What a solver on one rank's part of a decomposed mesh needs to reach the other ranks:
+/// their communicator and the part's halo plans (core/parallel/LocalMesh). The default (no
+/// communicator) is a whole mesh on one rank.
+struct RankDomain {
+  MPI_Comm comm = MPI_COMM_NULL;
+  HaloPlan cells;
+  HaloPlan nodes;
+  bool distributed() const { return comm != MPI_COMM_NULL; }
+};
+
 /// \brief One kind of entity's halo on one rank. Not copyable (it owns MPI requests).
 class Halo {
  public:
@@ -32,6 +42,13 @@ class Halo {
   void exchange(const ExecSpace& exec, const RealView& x) const;
   /// \brief The same for the three columns of an n x 3 field, in one message per neighbour.
   void exchange(const ExecSpace& exec, const Real3View& x) const;
+  /// \brief The same for the nine entries of an n x 3 x 3 field (a gradient of a vector).
+  void exchange(const ExecSpace& exec, const Kokkos::View<real* [3][3], MemSpace>& x) const;
+
+  /// \brief The exchanges above: pack, transfer and unpack a field of K columns (View: K = 1, 3
+  /// or 9). Public only because nvcc compiles extended device lambdas solely in public members.
+  template <int K, class View>
+  void exchangeColumns(const ExecSpace& exec, const View& x) const;
 
   int neighbours() const { return static_cast<int>(neighbours_.size()); }
   lid_t nOwned() const { return nOwned_; }
@@ -44,6 +61,8 @@ class Halo {
  private:
   void start(int components) const;
   void finish(int components) const;
+  /// Send buffer filled (device): send, receive, and return the received buffer (device).
+  void transfer(const ExecSpace& exec, int components) const;
 
   MPI_Comm comm_ = MPI_COMM_NULL;
   std::vector<int> neighbours_;
@@ -52,7 +71,7 @@ class Halo {
   lid_t nOwned_ = 0, nLocal_ = 0;
   RealView sendBuf_, recvBuf_;
   RealView::HostMirror sendHost_, recvHost_;
-  mutable std::vector<MPI_Request> requests_[2];  ///< persistent: [0] one column, [1] three
+  mutable std::vector<MPI_Request> requests_[3];  ///< persistent: [0] one column, [1] three, [2] nine
 };
 
 }  // namespace mfsi

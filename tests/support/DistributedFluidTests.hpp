@@ -1,0 +1,41 @@
+#pragma once
+/// \file
+/// \brief The distributed fluid tests themselves, for the rank count `kRanks` that the including
+/// file (tests/mpi/test_distributed_fluid_np<N>.cpp) defines: PIMPLE steps on each rank's part
+/// give the whole mesh's velocity and pressure to 1e-10, and the same bits when repeated, for a 3D
+/// lid-driven cavity (METIS and a random, ghost-heavy partition), the cavity on a distorted mesh
+/// (non-orthogonal corrections) and the unstructured Gmsh cylinder mesh (its inlet profile spans
+/// ranks at 4).
+#include "core/parallel/Partition.hpp"
+#include "support/DistributedFluid.hpp"
+#include "support/DistributedFluidCases.hpp"
+#include "support/LocalParts.hpp"
+
+namespace mfsi::test {
+inline std::vector<int> metisParts(const HexMeshInput& in, int parts) {
+  PartitionOptions opt;
+  opt.parts = parts;
+  return partitionCells(in, opt).cellRank;
+}
+}  // namespace mfsi::test
+
+TEST(DistributedFluid, CavityOnMetisParts) {
+  const mfsi::HexMeshInput in = mfsi::test::cavityCube(8);
+  mfsi::test::checkDistributedFluid(in, mfsi::test::cavityOptions(), mfsi::test::metisParts(in, kRanks), 4, 0.05);
+}
+
+TEST(DistributedFluid, CavityOnARandomPartition) {
+  const mfsi::HexMeshInput in = mfsi::test::cavityCube(6);
+  mfsi::test::checkDistributedFluid(in, mfsi::test::cavityOptions(),
+                                    mfsi::test::randomPartition(in.cells.size(), kRanks), 3, 0.05);
+}
+
+TEST(DistributedFluid, DistortedCavity) {
+  const mfsi::HexMeshInput in = mfsi::test::cavityCube(8, 0.25);
+  mfsi::test::checkDistributedFluid(in, mfsi::test::cavityOptions(1), mfsi::test::metisParts(in, kRanks), 3, 0.05);
+}
+
+TEST(DistributedFluid, UnstructuredCylinder) {
+  const mfsi::HexMeshInput in = mfsi::test::gradedCylinder();
+  mfsi::test::checkDistributedFluid(in, mfsi::test::cylinderOptions(), mfsi::test::metisParts(in, kRanks), 3, 0.01);
+}
