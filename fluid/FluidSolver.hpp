@@ -148,6 +148,8 @@ class FluidSolver {
   lid_t ownedCells() const { return nRows_; }
   /// The ranks' sums and ghost exchanges (no-ops on one rank).
   const SolverComm& comm() const { return comm_; }
+  /// The ghost cells' halo (null on one rank).
+  const Halo* cellHalo() const { return cellHalo_.get(); }
   /// Number of `beginStep` calls so far.
   int stepIndex() const { return nSteps_; }
 

@@ -90,6 +90,8 @@ void Halo::transfer(const ExecSpace& exec, int components) const {
   exec.fence();
   start(components);
   finish(components);
+  bytesSent_ += sendBytes(components);
+  messagesSent_ += sendMessages();
   Kokkos::deep_copy(exec, recvBuf_, recvHost_);
 }
 

@@ -57,6 +57,9 @@ class Halo {
   std::int64_t sendBytes(int components) const;
   /// \brief Messages sent by this rank per exchange (empty ones are not sent).
   int sendMessages() const;
+  /// \brief Bytes and messages this rank has sent in all exchanges so far.
+  std::int64_t bytesSent() const { return bytesSent_; }
+  std::int64_t messagesSent() const { return messagesSent_; }
 
  private:
   void start(int components) const;
@@ -71,6 +74,7 @@ class Halo {
   lid_t nOwned_ = 0, nLocal_ = 0;
   RealView sendBuf_, recvBuf_;
   RealView::HostMirror sendHost_, recvHost_;
+  mutable std::int64_t bytesSent_ = 0, messagesSent_ = 0;
   mutable std::vector<MPI_Request> requests_[3];  ///< persistent: [0] one column, [1] three, [2] nine
 };
 
