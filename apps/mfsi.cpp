@@ -202,12 +202,23 @@ int commandRun(std::string sceneArg, const std::vector<std::string>& sets, std::
   bool started = false;  ///< the run has begun writing into `out`
   std::unique_ptr<mfsi::Simulation> sim;
   if (out.empty()) out = (fs::path("results") / fs::path(sceneArg).stem()).string();
+  int prepared = 1;
   try {
     if (rank == 0 && !continueFiles) prepareOutput(out, overwrite);
   } catch (const mfsi::InputError& e) {
     std::cerr << "error: " << e.what() << "\n";  // no summary: the folder is not ours to write
-    return 2;
+    prepared = 0;
   }
+  if (summary.ranks > 1) MPI_Bcast(&prepared, 1, MPI_INT, 0, MPI_COMM_WORLD);  // every rank stops, or none
+  if (!prepared) return 2;
+  // On several ranks the solvers agree on every global decision (residuals, divergence, input
+  // checks), so those errors arise on every rank at once and rank 0 reports them. An error of one
+  // rank alone (its files, an internal failure) leaves the others waiting in a collective: that
+  // rank reports it, rank 0 writes the summary if it is the one, and MPI_Abort stops them all.
+  bool abortOthers = false;
+  auto report = [&](const std::string& line) {
+    if (rank == 0 || abortOthers) std::cerr << line << "\n";
+  };
   try {
     const fs::path file = resolveScene(sceneArg);
     const auto cfg = mfsi::SceneConfig::load(file.string(), mfsi::sceneSchema(), sets);
@@ -231,7 +242,7 @@ int commandRun(std::string sceneArg, const std::vector<std::string>& sets, std::
                   << sim->completedTime() << ")\n";
     }
     started = true;
-    mfsi::writeTextAtomically(out + "/scene.yaml", resolved);
+    if (rank == 0) mfsi::writeTextAtomically(out + "/scene.yaml", resolved);
     const auto result = sim->run(out, rank == 0 && mfsi::stdoutIsTerminal(), continueFiles);
     summary.steps = result.steps;
     summary.simTime = result.simTime;
@@ -243,37 +254,41 @@ int commandRun(std::string sceneArg, const std::vector<std::string>& sets, std::
       summary.status = "unconverged";
       summary.error = "steady state not reached in " + std::to_string(result.steps) + " steps: " +
                       result.steadyStateMissed + " (more steps: time.endTime; or time.stopAtSteadyState: false)";
-      std::cerr << "unconverged: " << summary.error << "\n";
+      report("unconverged: " + summary.error);
       code = 5;
     }
     if (result.interruptedBy != 0) {
       summary.status = "interrupted";
       summary.error = std::string("stopped by ") + mfsi::signalName(result.interruptedBy) + " after step " +
                       std::to_string(result.steps) + "; continue with: mfsi run --restart " + out;
-      std::cerr << "interrupted: " << summary.error << " (checkpoint " << result.lastCheckpoint << ")\n";
+      report("interrupted: " + summary.error +
+             (result.lastCheckpoint.empty() ? "" : " (checkpoint " + result.lastCheckpoint + ")"));
       code = 128 + result.interruptedBy;
     }
   } catch (const mfsi::InputError& e) {
     summary.status = "error";
     summary.error = e.what();
-    std::cerr << "error: " << e.what() << "\n";
+    report(std::string("error: ") + e.what());
     code = 2;
     // A restart that cannot continue leaves the folder of the run it was to continue untouched.
     if (continueFiles && !started) return code;
   } catch (const mfsi::DivergenceError& e) {
     summary.status = "diverged";
     summary.error = e.what();
-    std::cerr << "diverged: " << e.what() << "\n";
+    report(std::string("diverged: ") + e.what());
     code = 3;
   } catch (const mfsi::OutputError& e) {
     summary.status = "error";
     summary.error = std::string("output: ") + e.what();
-    std::cerr << "error: results not saved: " << e.what() << "\n";
+    abortOthers = summary.ranks > 1;
+    report(std::string("error: results not saved: ") + e.what());
     code = 4;
   } catch (const std::exception& e) {
     summary.status = "error";
     summary.error = std::string("internal error: ") + e.what();
-    std::cerr << "internal error: " << e.what() << "\n";
+    abortOthers = summary.ranks > 1;
+    report(std::string("internal error") + (summary.ranks > 1 ? " on rank " + std::to_string(rank) : "") + ": " +
+           e.what());
     code = 1;
   }
   if (sim) {
@@ -300,6 +315,7 @@ int commandRun(std::string sceneArg, const std::vector<std::string>& sets, std::
       if (code == 0) code = 4;
     }
   }
+  if (abortOthers) MPI_Abort(MPI_COMM_WORLD, code);
   return code;
 }
 
@@ -414,13 +430,10 @@ int main(int argc, char** argv) {
       MPI_Comm_size(MPI_COMM_WORLD, &worldSize);
       MPI_Comm_rank(MPI_COMM_WORLD, &worldRank);
     }
-    if (app.got_subcommand("run") && worldSize > 1) {
-      // Several ranks would each run the whole scene into the same files: refused until the
-      // solvers run distributed (`mfsi partition` shows the decomposition they will use).
+    if (app.got_subcommand("run") && worldSize > 1 && !restart.empty()) {
       if (worldRank == 0)
-        std::cerr << "error: mfsi run does not run distributed yet (started on " << worldSize
-                  << " ranks): run it on one rank (threads: --threads); `mfsi partition SCENE -n " << worldSize
-                  << "` shows the decomposition\n";
+        std::cerr << "error: --restart runs on one rank (started on " << worldSize
+                  << " ranks): several ranks write no checkpoints yet\n";
       code = 2;
     } else if (app.got_subcommand("partition")) {
       code = worldRank == 0 ? commandPartition(scene, sets, partitionRanks, partitionOut) : 0;

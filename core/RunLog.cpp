@@ -270,7 +270,7 @@ bool stdoutIsTerminal() { return ::isatty(STDOUT_FILENO) == 1; }
 
 Progress::Progress(long long totalSteps, double endTime, bool terminal, int plainEvery)
     : total_(totalSteps), endTime_(endTime), terminal_(terminal), plainEvery_(plainEvery), start_(wallSeconds()) {
-  if (plainEvery_ <= 0) plainEvery_ = static_cast<int>(std::max<long long>(1, totalSteps / 10));
+  if (plainEvery_ == 0) plainEvery_ = static_cast<int>(std::max<long long>(1, totalSteps / 10));
 }
 
 void Progress::update(long long step, double simTime) {
@@ -282,7 +282,7 @@ void Progress::update(long long step, double simTime) {
     std::printf("\r  step %lld/%lld  t = %.6g  elapsed %.1f s  ETA %.1f s   ", step, total_, simTime, elapsed, eta);
     std::fflush(stdout);
     drew_ = true;
-  } else if (step % plainEvery_ == 0 || step == total_) {
+  } else if (plainEvery_ > 0 && (step % plainEvery_ == 0 || step == total_)) {
     std::printf("  step %lld/%lld  t = %.6g  elapsed %.1f s  ETA %.1f s\n", step, total_, simTime, elapsed, eta);
   }
 }

@@ -88,7 +88,7 @@ class StepLog {
 };
 
 /// \brief One-line progress display (step, simulated time, ETA) on a terminal; plain lines at
-/// most every `plainEvery` steps otherwise.
+/// most every `plainEvery` steps otherwise (0: a tenth of the run; negative: none).
 class Progress {
  public:
   Progress(long long totalSteps, double endTime, bool terminal, int plainEvery = 0);

@@ -4,6 +4,7 @@
 #include "fluid/Gradient.hpp"
 #include "fluid/Loads.hpp"
 #include "core/io/HostCopy.hpp"
+#include "core/parallel/Gather.hpp"
 
 #include <cmath>
 #include <sstream>
@@ -14,16 +15,19 @@ using namespace fluid;
 
 namespace {
 
-// The cell whose centroid (host copy C) is nearest to x.
+// The cell among the first n (all: -1) whose centroid (host copy C) is nearest to x, and its
+// squared distance.
 template <class Centroids>
-int nearestCell(const Centroids& C, const Vec3& x) {
+int nearestCell(const Centroids& C, const Vec3& x, int n = -1, double* distance2 = nullptr) {
   auto dist2 = [&](int i) {
     return (C(i, 0) - x[0]) * (C(i, 0) - x[0]) + (C(i, 1) - x[1]) * (C(i, 1) - x[1]) +
            (C(i, 2) - x[2]) * (C(i, 2) - x[2]);
   };
+  if (n < 0) n = static_cast<int>(C.extent(0));
   int best = 0;
-  for (int c = 1; c < static_cast<int>(C.extent(0)); ++c)
+  for (int c = 1; c < n; ++c)
     if (dist2(c) < dist2(best)) best = c;
+  if (distance2) *distance2 = n > 0 ? dist2(best) : 1e300;
   return best;
 }
 
@@ -40,12 +44,24 @@ double dot(const Vec3& a, const Vec3& b) { return a[0] * b[0] + a[1] * b[1] + a[
 
 }  // namespace
 
-FluidModule::FluidModule(const HexMesh& mesh, const FluidOptions& options, FluidReports reports)
+FluidModule::FluidModule(const HexMesh& mesh, const FluidOptions& options, FluidReports reports,
+                         const RankDomain& domain)
     : Module("fluid"),
-      solver_(mesh, options),
+      solver_(mesh, options, domain),
       reports_(std::move(reports)),
       runaway_(solver_, options.divergenceVelocityFactor) {
   if (options.means.enabled) means_.emplace(mesh.nCells(), options.means);
+  if (domain.distributed()) {
+    if (!reports_.pressureDifferences.empty())
+      throw InputError("fluid.pressureDifferences: not yet on several ranks (run the scene on one rank)");
+    if (reports_.ghia.enabled) throw InputError("fluid.ghiaCheck: not yet on several ranks (run the scene on one rank)");
+    comm_ = domain.comm;
+    auto gid = Kokkos::create_mirror_view_and_copy(HostSpace(), mesh.cellGlobalIds());
+    ownedIds_.assign(gid.data(), gid.data() + mesh.nOwnedCells());
+    long long owned = mesh.nOwnedCells(), all = 0;
+    MPI_Allreduce(&owned, &all, 1, MPI_LONG_LONG, MPI_SUM, comm_);
+    globalCells_ = static_cast<std::size_t>(all);
+  }
   if (reports_.probes.empty()) return;
   // Nearest cell centroids, found once on the mesh as built.
   const std::size_t n = reports_.probes.size();
@@ -53,7 +69,20 @@ FluidModule::FluidModule(const HexMesh& mesh, const FluidOptions& options, Fluid
   probeValues_ = RealView("mfsi::fluid::probes::values", 4 * n);
   auto C = Kokkos::create_mirror_view_and_copy(HostSpace(), solver_.geometry().cellCentroid);
   auto h = Kokkos::create_mirror_view(probeCells_);
-  for (std::size_t i = 0; i < n; ++i) h(i) = nearestCell(C, reports_.probes[i].point);
+  for (std::size_t i = 0; i < n; ++i) {
+    // On a decomposed mesh: the nearest owned cell of each rank; the nearest of those (the lowest
+    // rank on a tie) gives the probe's value.
+    double d2 = 0;
+    h(i) = nearestCell(C, reports_.probes[i].point, comm_ == MPI_COMM_NULL ? -1 : mesh.nOwnedCells(), &d2);
+    if (comm_ == MPI_COMM_NULL) continue;
+    struct {
+      double d;
+      int rank;
+    } mine{d2, 0}, best{0, 0};
+    MPI_Comm_rank(comm_, &mine.rank);
+    MPI_Allreduce(&mine, &best, 1, MPI_DOUBLE_INT, MPI_MINLOC, comm_);
+    probeOwner_.push_back(best.rank);
+  }
   Kokkos::deep_copy(probeCells_, h);
   probePoints_ = Real3View("mfsi::fluid::probes::points", n);
   auto hp = Kokkos::create_mirror_view(probePoints_);
@@ -87,7 +116,17 @@ std::vector<double> FluidModule::probeValues() const {
           values(4 * i + 1 + k) = U(c, k) + gu(c, 0, k) * d[0] + gu(c, 1, k) * d[1] + gu(c, 2, k) * d[2];
       });
   auto h = Kokkos::create_mirror_view_and_copy(HostSpace(), values);
-  return std::vector<double>(h.data(), h.data() + h.extent(0));
+  std::vector<double> v(h.data(), h.data() + h.extent(0));
+  if (comm_ != MPI_COMM_NULL) {
+    // Each probe's values from the rank that holds it, summed with the others' zeros.
+    int rank = 0;
+    MPI_Comm_rank(comm_, &rank);
+    for (std::size_t i = 0; i < probeOwner_.size(); ++i)
+      if (probeOwner_[i] != rank)
+        for (int k = 0; k < 4; ++k) v[4 * i + k] = 0.0;
+    solver_.comm().globalSum(v.data(), static_cast<int>(v.size()));
+  }
+  return v;
 }
 
 void FluidModule::advance(const TimeState& t) {
@@ -162,13 +201,18 @@ void FluidModule::appendStepValues(std::vector<double>& v) const {
 
 void FluidModule::addOutputFields(io::FieldFrame& frame) {
   io::OutputGrid* grid = frame.find("mesh");
-  if (!grid) return;
-  const std::size_t n = static_cast<std::size_t>(solver_.mesh().nCells());
-  grid->addCellField("U", 3, io::hostValues(solver_.velocity(), n));
-  grid->addCellField("p", 1, io::hostValues(solver_.pressure(), n));
+  if (comm_ == MPI_COMM_NULL && !grid) return;
+  // On a decomposed mesh every rank sends its owned cells; rank 0 holds the frame's grid.
+  const std::size_t n = static_cast<std::size_t>(comm_ == MPI_COMM_NULL ? solver_.mesh().nCells() : ownedIds_.size());
+  auto add = [&](const char* name, int components, std::vector<double> values) {
+    if (comm_ != MPI_COMM_NULL) values = gatherByGlobalId(comm_, 0, ownedIds_, values, components, globalCells_);
+    if (grid) grid->addCellField(name, components, std::move(values));
+  };
+  add("U", 3, io::hostValues(solver_.velocity(), n));
+  add("p", 1, io::hostValues(solver_.pressure(), n));
   if (means_) {
-    grid->addCellField("UMean", 3, io::hostValues(means_->velocity(), n));
-    grid->addCellField("pMean", 1, io::hostValues(means_->pressure(), n));
+    add("UMean", 3, io::hostValues(means_->velocity(), n));
+    add("pMean", 1, io::hostValues(means_->pressure(), n));
   }
 }
 
@@ -233,7 +277,8 @@ ModuleEntry fluidModuleEntry() {
             FluidReports r = readFluidReports(section, *ctx.mesh, o);
             std::vector<std::unique_ptr<Module>> v;
             try {
-              v.push_back(std::make_unique<FluidModule>(*ctx.mesh, o, std::move(r)));
+              v.push_back(std::make_unique<FluidModule>(*ctx.mesh, o, std::move(r),
+                                                        ctx.domain ? *ctx.domain : RankDomain{}));
             } catch (const InputError& e) {
               // Solver-side checks (inconsistent boundary options) carry no scene location.
               throw InputError(section.where(), e.what());

@@ -16,7 +16,11 @@ class FluidModule final : public Module {
  public:
   /// Solver on `mesh` (which must outlive the module) with `options`; `reports` name what
   /// addMetrics computes.
-  FluidModule(const HexMesh& mesh, const fluid::FluidOptions& options, FluidReports reports);
+  /// On one rank's part of a decomposed mesh `domain` names the ranks: the solver runs
+  /// distributed, probes and forces are global, output fields are gathered onto rank 0 (the
+  /// pressure-difference and Ghia reports are refused there, not yet distributed).
+  FluidModule(const HexMesh& mesh, const fluid::FluidOptions& options, FluidReports reports,
+              const RankDomain& domain = {});
   /// One time step (steady: `pimple.outerCorrectors` SIMPLE iterations), then endStep. Throws
   /// DivergenceError when the solver reports a breakdown or non-finite fields, or on runaway growth.
   void advance(const TimeState& t) override;
@@ -72,6 +76,12 @@ class FluidModule final : public Module {
   fluid::RunawayGuard runaway_;
   std::optional<fluid::RunningMean> means_;
   long long outerTotal_ = 0, pressureTotal_ = 0, momentumTotal_ = 0;
+  /// A decomposed mesh: the ranks, the owned cells' global ids, the whole mesh's cell count, and
+  /// the rank whose nearest cell holds each probe.
+  MPI_Comm comm_ = MPI_COMM_NULL;
+  std::vector<gid_t> ownedIds_;
+  std::size_t globalCells_ = 0;
+  std::vector<int> probeOwner_;
 };
 
 /// Catalogue entry of the `fluid` section (needs the scene's `mesh`).

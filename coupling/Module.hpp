@@ -13,6 +13,7 @@
 #include "core/Timers.hpp"
 #include "core/io/Checkpoint.hpp"
 #include "core/io/FieldOutput.hpp"
+#include "core/parallel/Halo.hpp"
 
 #include <functional>
 #include <map>
@@ -26,6 +27,8 @@ namespace mfsi {
 struct SimulationContext {
   HexMesh* mesh = nullptr;  ///< null when the scene has no `mesh` section
   MeshGeometry* geometry = nullptr;
+  /// On several ranks: `mesh` is this rank's part and this names the others (null: one rank).
+  const RankDomain* domain = nullptr;
   Timers* timers = nullptr;
   /// The modules built so far: a module that composes others (the coupling) takes them from here.
   std::vector<std::unique_ptr<class Module>>* built = nullptr;

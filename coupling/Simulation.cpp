@@ -3,6 +3,8 @@
 #include "core/Interrupt.hpp"
 #include "core/MeshConfig.hpp"
 #include "core/io/HostCopy.hpp"
+#include "core/parallel/LocalMesh.hpp"
+#include "core/parallel/Partition.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -96,10 +98,19 @@ Simulation::Simulation(const SceneConfig& scene) {
     nSteps_ = static_cast<long long>(steps);
   }
 
+  int mpiUp = 0;
+  MPI_Initialized(&mpiUp);
+  if (mpiUp) {
+    MPI_Comm_size(MPI_COMM_WORLD, &ranks_);
+    MPI_Comm_rank(MPI_COMM_WORLD, &rank_);
+  }
+  if (ranks_ > 1) decompose(scene);
+
   SimulationContext ctx;
   if (hasMesh_) {
-    ctx.mesh = &mesh_;
-    ctx.geometry = &geometry_;
+    ctx.mesh = ranks_ > 1 ? &localMesh_ : &mesh_;
+    ctx.geometry = ranks_ > 1 ? &localGeometry_ : &geometry_;
+    if (ranks_ > 1) ctx.domain = &domain_;
   }
   ctx.timers = &timers_;
   ctx.built = &modules_;
@@ -115,6 +126,31 @@ Simulation::Simulation(const SceneConfig& scene) {
   }
   if (!hasMesh_ && modules_.empty())
     throw InputError(scene.where(), "the scene names nothing to simulate: give at least a 'mesh' or a physics section");
+}
+
+void Simulation::decompose(const SceneConfig& scene) {
+  // What runs on several ranks today: a fluid on the scene mesh, its field output and reports.
+  // The structure and the coupling run on one rank; so do checkpoints and restarts.
+  const std::string how = " (run it on one rank: without mpirun, or mpirun -np 1; threads: --threads)";
+  if (!hasMesh_) throw InputError(scene.where(), "a scene without a mesh runs on one rank" + how);
+  for (const auto& entry : moduleCatalogue())
+    if (entry.section != "fluid" && scene.has(entry.section))
+      throw InputError(scene.where(entry.section),
+                       "'" + entry.section + "' does not run on several ranks yet; a scene runs its fluid alone there" + how);
+  if (checkpoint_.everySteps > 0 || checkpoint_.wallSeconds > 0 || checkpoint_.final)
+    throw InputError(scene.where("output.checkpoint"), "checkpoints are not written on several ranks yet" + how);
+  ScopedTimer t(timers_, "decompose");
+  PartitionOptions opt;
+  opt.parts = ranks_;
+  const Partition part = partitionGraph(cellDualGraph(mesh_), opt);
+  const LocalMeshPart lp = localMeshPart(mesh_, part.cellRank, ranks_, rank_);
+  localMesh_ = buildHexMesh(lp.input);
+  localGeometry_ = allocateGeometry(localMesh_);
+  computeGeometry(ExecSpace(), localMesh_, localGeometry_);
+  domain_.comm = MPI_COMM_WORLD;
+  domain_.cells = lp.cells;
+  domain_.nodes = lp.nodes;
+  Kokkos::fence();
 }
 
 void Simulation::meshMetrics(std::map<std::string, double>& m) const {
@@ -137,7 +173,7 @@ io::FieldFrame Simulation::fieldFrame(double time, long long step) {
   io::FieldFrame frame;
   frame.time = time;
   frame.step = step;
-  if (hasMesh_) {
+  if (hasMesh_ && rank_ == 0) {
     io::OutputGrid g;
     g.name = "mesh";
     g.shape = io::CellShape::Hexahedron;
@@ -174,17 +210,24 @@ RunResult Simulation::run(const std::string& outDir, bool terminal, bool continu
   std::vector<std::string> columns = {"step", "time", "wall_s"};
   for (const Module* m : reporting_)
     for (const auto& c : m->stepColumns()) columns.push_back(m->name() + "." + c);
-  StepLog log = continueFiles ? StepLog(outDir + "/steps.csv", columns, ts.step - firstStep_)
-                              : StepLog(outDir + "/steps.csv", columns);
+  // On several ranks rank 0 writes every file; the others take part in what the rows and frames
+  // gather (probes, forces, fields) and write nothing.
+  const bool writer = rank_ == 0;
+  StepLog log;
+  if (writer)
+    log = continueFiles ? StepLog(outDir + "/steps.csv", columns, ts.step - firstStep_)
+                        : StepLog(outDir + "/steps.csv", columns);
   const OutputStart outputStart{ts.step, continueFiles, firstStep_};
-  for (Module* m : reporting_) m->openOutput(outDir, outputStart);
-  Progress progress(nSteps, time_.endTime, terminal);
+  if (writer)
+    for (Module* m : reporting_) m->openOutput(outDir, outputStart);
+  Progress progress(nSteps, time_.endTime, terminal, writer ? 0 : -1);
   io::FieldSeries fields(outDir);
   if (continueFiles) fields.restore(start_.fields, ts.step);
   long long lastFrameStep = start_.restored ? start_.lastFrameStep : -1;
   auto writeFrame = [&] {
     ScopedTimer t(timers_, "output");
-    fields.write(fieldFrame(ts.time, ts.step));
+    io::FieldFrame frame = fieldFrame(ts.time, ts.step);
+    if (writer) fields.write(frame);
     lastFrameStep = ts.step;
   };
   double nextFrameTime = start_.restored ? start_.nextFrameTime : fieldOutput_.interval;
@@ -215,7 +258,7 @@ RunResult Simulation::run(const std::string& outDir, bool terminal, bool continu
     completedTime_ = ts.time;
     std::vector<double> row = {double(ts.step), ts.time, wallSeconds() - start};
     for (const Module* m : reporting_) m->appendStepValues(row);
-    log.row(row);
+    if (writer) log.row(row);
     bool frame = fieldOutput_.everySteps > 0 && ts.step % fieldOutput_.everySteps == 0;
     if (fieldOutput_.interval > 0 && ts.time >= nextFrameTime - 1e-9 * ts.dt) {
       frame = true;
@@ -223,8 +266,14 @@ RunResult Simulation::run(const std::string& outDir, bool terminal, bool continu
     }
     if (frame) writeFrame();
     progress.update(ts.step, ts.time);
-    if (interruptSignal() != 0) {
-      r.interruptedBy = interruptSignal();
+    int signal = interruptSignal();
+    if (ranks_ > 1) {  // every rank stops after the same step
+      int any = 0;
+      MPI_Allreduce(&signal, &any, 1, MPI_INT, MPI_MAX, MPI_COMM_WORLD);
+      signal = any;
+    }
+    if (signal != 0) {
+      r.interruptedBy = signal;
       break;
     }
     const bool byStep = checkpoint_.everySteps > 0 && ts.step % checkpoint_.everySteps == 0;
@@ -240,7 +289,8 @@ RunResult Simulation::run(const std::string& outDir, bool terminal, bool continu
     for (const auto& m : modules_)
       if (m->solvesSteadyState() && !m->steadyStateReached())
         r.steadyStateMissed += (r.steadyStateMissed.empty() ? "" : "; ") + m->steadyStateGap();
-  if ((r.interruptedBy != 0 || checkpoint_.final) && lastCheckpointStep != ts.step) checkpoint();
+  // (Several ranks write no checkpoint yet: an interrupted distributed run stops without one.)
+  if ((r.interruptedBy != 0 || checkpoint_.final) && lastCheckpointStep != ts.step && ranks_ == 1) checkpoint();
   if (fieldOutput_.final && lastFrameStep != ts.step && r.interruptedBy == 0) writeFrame();
   progress.finish();
   r.steps = ts.step;

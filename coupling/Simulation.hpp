@@ -73,6 +73,9 @@ class Simulation {
 
   /// True when the scene has a `mesh` section (a rigid-only or membrane-only scene has none).
   bool hasMesh() const { return hasMesh_; }
+  /// Ranks of MPI_COMM_WORLD the run is decomposed over (1: the whole mesh here), and this one.
+  int ranks() const { return ranks_; }
+  int rank() const { return rank_; }
   const HexMesh& mesh() const { return mesh_; }
   const std::vector<std::unique_ptr<Module>>& modules() const { return modules_; }
   Timers& timers() { return timers_; }
@@ -91,10 +94,19 @@ class Simulation {
   /// from the reference mesh, each cell's scaled Jacobian) and every module's fields.
   io::FieldFrame fieldFrame(double time, long long step);
 
+  /// Build this rank's part of mesh_ (METIS over the ranks); throws InputError for what does not
+  /// run on several ranks yet.
+  void decompose(const SceneConfig& scene);
+
   Timers timers_;
   bool hasMesh_ = false;
-  HexMesh mesh_;
+  HexMesh mesh_;  ///< the whole mesh (every rank builds it; rank 0 writes it)
   MeshGeometry geometry_;
+  /// On several ranks: this rank's part of mesh_, its geometry, and the ranks it talks to.
+  int ranks_ = 1, rank_ = 0;
+  HexMesh localMesh_;
+  MeshGeometry localGeometry_;
+  RankDomain domain_;
   TimeOptions time_;
   long long nSteps_ = 0;  ///< from time_ (checked at set-up)
   FieldOutputOptions fieldOutput_;

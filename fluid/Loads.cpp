@@ -48,14 +48,18 @@ void boundaryTraction(const FluidSolver& fluid, const std::string& patch, const 
 PatchLoads patchLoads(const FluidSolver& fluid, const std::string& name, const Vec3& point) {
   const auto idx = fluid.boundaryConditions().find(name);
   MFSI_CHECK(!idx.empty(), "fluid: patchLoads: no patch or baffle named '" << name << "'");
+  (void)fluid.velocityGradient();  // formed on every rank (it exchanges ghosts), with or without faces here
   PatchLoads out;
   ConstRealView sm = fluid.geometry().faceAreaMag;
   ConstReal3View fc = fluid.geometry().faceCentroid;
+  ConstIndexView own = fluid.mesh().faceOwner();
+  // On a decomposed mesh a ghost cell's patch faces are its owner rank's: counted there.
+  const lid_t nOwned = fluid.ownedCells();
   for (int i : idx) {
     const auto& p = fluid.mesh().patches()[i];
-    if (p.size == 0) continue;
+    // A rank without faces of the patch still takes part in the sum over ranks.
     Real3View tp("mfsi::fluid::loads::pressureTraction", p.size), tv("mfsi::fluid::loads::viscousTraction", p.size);
-    tractionRange(fluid, p.start, p.size, tp, tv);
+    if (p.size > 0) tractionRange(fluid, p.start, p.size, tp, tv);
     const lid_t start = p.start;
     const real x0 = point[0], y0 = point[1], z0 = point[2];
     real r[10] = {0, 0, 0, 0, 0, 0, 0, 0, 0, 0};
@@ -64,7 +68,7 @@ PatchLoads patchLoads(const FluidSolver& fluid, const std::string& name, const V
         KOKKOS_LAMBDA(lid_t k, real & a0, real & a1, real & a2, real & a3, real & a4, real & a5, real & a6, real & a7,
                       real & a8, real & a9) {
           const lid_t f = start + k;
-          const real A = sm(f);
+          const real A = own(f) < nOwned ? sm(f) : 0.0;
           const real fp[3] = {tp(k, 0) * A, tp(k, 1) * A, tp(k, 2) * A};
           const real fv[3] = {tv(k, 0) * A, tv(k, 1) * A, tv(k, 2) * A};
           const real ft[3] = {fp[0] + fv[0], fp[1] + fv[1], fp[2] + fv[2]};
@@ -81,6 +85,7 @@ PatchLoads patchLoads(const FluidSolver& fluid, const std::string& name, const V
           a9 += A;
         },
         r[0], r[1], r[2], r[3], r[4], r[5], r[6], r[7], r[8], r[9]);
+    fluid.comm().globalSum(r, 10);
     for (int k = 0; k < 3; ++k) {
       out.pressureForce[k] += r[k];
       out.viscousForce[k] += r[3 + k];

@@ -89,6 +89,10 @@ PrescribedVelocityScale prescribedVelocityScale(const FluidSolver& fluid) {
         lo[d] = n == 0 ? P(n, d) : std::min(lo[d], P(n, d));
         hi[d] = n == 0 ? P(n, d) : std::max(hi[d], P(n, d));
       }
+    for (int d = 0; d < 3; ++d) {  // the whole mesh's box on a decomposed one
+      lo[d] = -fluid.comm().globalMax(-lo[d]);
+      hi[d] = fluid.comm().globalMax(hi[d]);
+    }
     const real L = norm({hi[0] - lo[0], hi[1] - lo[1], hi[2] - lo[2]});
     s.gravity = std::sqrt(2 * g * L);
   }
@@ -110,20 +114,20 @@ real boundaryVelocityNow(const FluidSolver& fluid) {
         m = v > m ? v : m;
       },
       Kokkos::Max<real>(m2));
-  return std::sqrt(m2);
+  return std::sqrt(fluid.comm().globalMax(m2));
 }
 
 real maxVelocity(const FluidSolver& fluid) {
   ConstReal3View U = fluid.velocity();
   real m2 = 0;
   Kokkos::parallel_reduce(
-      "mfsi::fluid::maxVelocity", RangePolicy(ExecSpace(), 0, static_cast<lid_t>(U.extent(0))),
+      "mfsi::fluid::maxVelocity", RangePolicy(ExecSpace(), 0, fluid.ownedCells()),
       KOKKOS_LAMBDA(lid_t c, real & m) {
         const real v = U(c, 0) * U(c, 0) + U(c, 1) * U(c, 1) + U(c, 2) * U(c, 2);
         m = v > m ? v : m;
       },
       Kokkos::Max<real>(m2));
-  return std::sqrt(m2);
+  return std::sqrt(fluid.comm().globalMax(m2));
 }
 
 RunawayGuard::RunawayGuard(const FluidSolver& fluid, real factor)

@@ -1,6 +1,5 @@
 # `mfsi partition`: the flexible cavity over 3 ranks writes one rank per cell, keeps the membrane's
-# row of cells (the first 32 cells of the bottom block) on one rank, and refuses bad input; and
-# `mfsi run` under mpiexec on 2 ranks is refused (exit 2) instead of running the scene twice.
+# row of cells (the first 32 cells of the bottom block) on one rank, and refuses bad input.
 file(REMOVE_RECURSE ${WORK})
 execute_process(COMMAND ${MFSI} partition flexible-cavity -n 3 --out ${WORK}/fc3.txt
   RESULT_VARIABLE rc OUTPUT_VARIABLE o ERROR_VARIABLE e)
@@ -35,11 +34,3 @@ foreach(bad "-n;0" "-n;2000")
     message(SEND_ERROR "partition ${bad}: exit ${rc}, expected 2 and no file:\n${e}")
   endif()
 endforeach()
-find_program(MPIEXEC mpiexec)
-if(MPIEXEC)
-  execute_process(COMMAND ${MPIEXEC} --allow-run-as-root --oversubscribe -np 2 ${MFSI} run flexible-cavity
-    --out ${WORK}/run2 RESULT_VARIABLE rc OUTPUT_VARIABLE o ERROR_VARIABLE e)
-  if(rc EQUAL 0 OR EXISTS ${WORK}/run2/summary.json OR NOT e MATCHES "does not run distributed yet")
-    message(SEND_ERROR "mpiexec -np 2 mfsi run: exit ${rc}:\n${e}")
-  endif()
-endif()
