@@ -331,9 +331,6 @@ FluidSolver::FluidSolver(const HexMesh& mesh, const FluidOptions& options, const
                                         << " local cells) is not the mesh's (" << nRows_ << ", " << nCells_ << ")");
     cellHalo_ = std::make_unique<Halo>(domain.comm, domain.cells);
     comm_ = SolverComm(domain.comm, cellHalo_.get());
-    // The fused per-cell passes and CG's lattice are one-rank fast paths: the face-coefficient
-    // paths give the same fields.
-    opt_.fusedMomentumAssembly = false;
   }
   MFSI_CHECK(opt_.density > 0, "fluid: density must be positive (key fluid.density)");
   MFSI_CHECK(opt_.viscosity >= 0, "fluid: viscosity must be non-negative (key fluid.viscosity)");
@@ -1514,7 +1511,8 @@ void FluidSolver::assemblePressure(bool matrix) {
     // CG's lattice takes the values directly when the sparsity is a lattice (no CSR values, no
     // copy pass: 64^3 cavity ~3 ms per step at 1 thread); lines of one cell (nx or ny = 1) keep
     // CSR.
-    SymmetricLatticeMatrix* lattice = linear_.pressureLattice(Ap_);
+    // CG's lattice copy is a one-rank fast path (a rank's rows with ghost columns are no lattice).
+    SymmetricLatticeMatrix* lattice = cellHalo_ ? nullptr : linear_.pressureLattice(Ap_);
     pressureLattice_ = lattice != nullptr && lattice->nx() > 1 && lattice->ny() > 1 ? lattice : nullptr;
     if (pressureLattice_ != nullptr)
       assemblePressureLatticeFused(*pressureLattice_, /*stored=*/fusedPressureSource());
