@@ -10,7 +10,14 @@ SolverComm::SolverComm(MPI_Comm comm, const Halo* halo) : comm_(comm), halo_(hal
   if (comm_ != MPI_COMM_NULL) MPI_Comm_size(comm_, &size_);
 }
 
+namespace {
+std::int64_t gReductions = 0;
+}  // namespace
+
+std::int64_t SolverComm::reductions() { return gReductions; }
+
 void SolverComm::gatherSum(double* values, int n) const {
+  ++gReductions;
   // Every rank's partials, added in rank order: the same bits on every rank, every run.
   std::vector<double> all(static_cast<std::size_t>(n) * size_);
   MPI_Allgather(values, n, MPI_DOUBLE, all.data(), n, MPI_DOUBLE, comm_);
@@ -22,6 +29,7 @@ void SolverComm::gatherSum(double* values, int n) const {
 }
 
 double SolverComm::reduceMax(double local) const {
+  ++gReductions;
   double global = local;
   MPI_Allreduce(&local, &global, 1, MPI_DOUBLE, MPI_MAX, comm_);
   return global;

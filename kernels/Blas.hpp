@@ -19,6 +19,7 @@
 
 #include <array>
 #include <cstddef>
+#include <cstdint>
 #include <string>
 #include <type_traits>
 #include <vector>
@@ -47,6 +48,9 @@ class SolverComm {
     globalSum(&local, 1);
     return local;
   }
+  /// \brief Collective reductions (sums and maxima over more than one rank) this process has
+  /// made so far, over every SolverComm: the latency count of the scaling model (perf/).
+  static std::int64_t reductions();
   /// \brief Maximum of a per-rank value over all ranks.
   double globalMax(double local) const { return size_ > 1 ? reduceMax(local) : local; }
   /// \brief Refresh ghost entries [nRows, nCols) of `x` before it is multiplied by a matrix.

@@ -8,7 +8,9 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <map>
+#include <memory>
 #include <string>
 
 namespace mfsi {
@@ -146,6 +148,12 @@ void denseRows(const ExecSpace& exec, const Kokkos::View<double**, MemSpace>& in
 
 }  // namespace
 
+/// Coarsest-level gathers made by every DistributedAmg of this process (DistributedAmg::coarseGathers).
+std::int64_t& coarseGatherCount() {
+  static std::int64_t count = 0;
+  return count;
+}
+
 struct DistributedAmg::Impl {
   struct Level {
     HostCsr hA;
@@ -166,7 +174,8 @@ struct DistributedAmg::Impl {
   std::vector<DistributedAmgLevelInfo> info;
   // Coarsest level, gathered on every rank.
   Kokkos::View<double**, MemSpace> coarseInv;  ///< owned rows x all rows (gathered order)
-  RealView coarseAll;
+  RealView coarseAll, coarseOut;
+  std::unique_ptr<DistributedAmg> coarseAmg;   ///< a large gathered level's one-process AMG
   std::vector<int> coarseCounts, coarseDispls;
 
   SolverComm solverComm(const Level& L) const { return SolverComm(comm, L.halo.get()); }
@@ -392,9 +401,15 @@ struct DistributedAmg::Impl {
       allCols = colIds;
       allVals = vals;
     }
-    // Dense matrix in gathered order (rank by rank, each rank's rows in its order).
+    // Gathered order: rank by rank, each rank's rows in its order.
     std::map<long long, int> where;
     for (int k = 0; k < total; ++k) where[allRows[k]] = k;
+    coarseAll = RealView("mfsi::kernels::damg::coarseAll", total);
+    coarseAmg.reset();
+    if (ranks > 1 && total > opt.denseCoarseRows) {
+      gatheredAmg(exec, total, allRows, allLen, allCols, allVals, where);
+      return;
+    }
     Eigen::MatrixXd M = Eigen::MatrixXd::Zero(total, total);
     for (int k = 0, p = 0; k < total; ++k)
       for (int e = 0; e < allLen[k]; ++e, ++p) {
@@ -414,8 +429,37 @@ struct DistributedAmg::Impl {
     for (lid_t i = 0; i < n; ++i)
       for (int k = 0; k < total; ++k) h(i, k) = Pinv(coarseDispls[me] + i, k);
     Kokkos::deep_copy(coarseInv, h);
-    coarseAll = RealView("mfsi::kernels::damg::coarseAll", total);
-    (void)exec;
+  }
+
+  /// The gathered level as one process's matrix (every row owned, no ghosts) and its AMG, whose
+  /// own coarsest level is dense.
+  void gatheredAmg(const ExecSpace& exec, int total, const std::vector<long long>& allRows,
+                   const std::vector<int>& allLen, const std::vector<long long>& allCols,
+                   const std::vector<double>& allVals, const std::map<long long, int>& where) {
+    HostCsr g;
+    g.nRows = g.nCols = total;
+    for (int k = 0, p = 0; k < total; ++k) {
+      std::map<int, double> row;
+      for (int e = 0; e < allLen[k]; ++e, ++p) {
+        const auto it = where.find(allCols[p]);
+        MFSI_CHECK(it != where.end(), "distributed AMG: coarsest column " << allCols[p] << " has no row");
+        row[it->second] += allVals[p];
+      }
+      for (const auto& [c, v] : row) {
+        g.col.push_back(c);
+        g.val.push_back(v);
+      }
+      g.ptr.push_back(static_cast<lid_t>(g.col.size()));
+    }
+    HaloPlan plan;
+    plan.nOwned = plan.nLocal = total;
+    plan.sendOffsets = plan.recvOffsets = {0};
+    DistributedAmgOptions o = opt;
+    o.coarseSize = std::min(opt.coarseSize, opt.denseCoarseRows);
+    o.denseCoarseRows = std::numeric_limits<std::int64_t>::max();
+    coarseAmg = std::make_unique<DistributedAmg>(MPI_COMM_NULL, plan, std::vector<gid_t>(allRows.begin(), allRows.end()), o);
+    coarseAmg->setup(exec, toDevice(g, "mfsi::kernels::damg::gathered"));
+    coarseOut = RealView("mfsi::kernels::damg::coarseOut", total);
   }
 
   void coarseSolve(const ExecSpace& exec, Level& L) {
@@ -426,9 +470,17 @@ struct DistributedAmg::Impl {
       auto hb = Kokkos::create_mirror_view_and_copy(HostSpace(), Kokkos::subview(L.b, std::make_pair(0, n)));
       auto ha = Kokkos::create_mirror_view(coarseAll);
       MPI_Allgatherv(hb.data(), n, MPI_DOUBLE, ha.data(), coarseCounts.data(), coarseDispls.data(), MPI_DOUBLE, comm);
+      ++coarseGatherCount();
       Kokkos::deep_copy(exec, coarseAll, ha);
     }
-    denseRows(exec, coarseInv, coarseAll, L.x);
+    if (coarseAmg) {
+      coarseAmg->apply(exec, coarseAll, coarseOut);
+      const int first = coarseDispls[me];
+      Kokkos::deep_copy(exec, Kokkos::subview(L.x, std::make_pair(0, n)),
+                        Kokkos::subview(coarseOut, std::make_pair(first, first + n)));
+    } else {
+      denseRows(exec, coarseInv, coarseAll, L.x);
+    }
   }
 
   /// Fourth-kind Chebyshev smoothing in D^-1 A on [0, lambda_max] (Lottes 2023, as kernels/Amg):
@@ -489,6 +541,8 @@ DistributedAmg::DistributedAmg(MPI_Comm comm, const HaloPlan& plan, std::vector<
 
 DistributedAmg::~DistributedAmg() = default;
 
+std::int64_t DistributedAmg::coarseGathers() { return coarseGatherCount(); }
+
 const std::vector<DistributedAmgLevelInfo>& DistributedAmg::levels() const { return impl_->info; }
 
 void DistributedAmg::setup(const ExecSpace& exec, const CsrMatrix& A) {
@@ -506,7 +560,9 @@ void DistributedAmg::setup(const ExecSpace& exec, const CsrMatrix& A) {
   m.finishLevel(exec, m.levels.back(), 0);
   while (static_cast<int>(m.levels.size()) < m.opt.maxLevels && m.info.back().rows > m.opt.coarseSize)
     if (!m.coarsen(exec, m.levels.size() - 1)) break;
-  MFSI_CHECK(m.info.back().rows <= 20000, "distributed AMG: the coarsest level still has "
+  // One rank inverts its coarsest level densely; several gather it onto every rank.
+  MFSI_CHECK(m.info.back().rows <= (m.ranks > 1 ? 4000000 : 20000),
+             "distributed AMG: the coarsest level still has "
                                               << m.info.back().rows << " rows (raise maxLevels)");
   m.gatherCoarsest(exec);
 }

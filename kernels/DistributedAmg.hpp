@@ -11,8 +11,10 @@
 ///    the coarse operators keep the coupling between ranks: A_c = R (A P) with R = P^T, rows of P
 ///    and of A P sent to the ranks that hold them as ghosts (core/parallel/RowExchange);
 ///  - each level has its own halo (the coarse ghosts a rank's rows and prolongator touch);
-///  - once a level has at most `coarseSize` rows over all ranks it is gathered onto every rank
-///    and solved by a dense pseudo-inverse (the same on every rank, so deterministic);
+///  - once a level has at most `coarseSize` rows over all ranks (or cannot coarsen further) it is
+///    gathered onto every rank and solved there, the same on every rank (so deterministic): by a
+///    dense pseudo-inverse up to `denseCoarseRows` rows, above that by one V-cycle of a
+///    one-process DistributedAmg of the gathered matrix;
 ///  - symmetric V-cycle with fourth-kind Chebyshev smoothing in D^{-1} A (lambda_max from power
 ///    iterations, boosted by 1.1), every product after a halo exchange; every sum in a fixed order.
 /// One rank is the same algorithm with no communication (the reference the distributed
@@ -34,6 +36,11 @@ struct DistributedAmgOptions {
   double prolongationDamping = 1.45;  ///< omega lambda_max of the prolongator smoothing (kernels/Amg's)
   int chebyshevDegree = 2;          ///< of the fourth-kind Chebyshev smoother
   std::int64_t coarseSize = 300;    ///< rows over all ranks at or below which a level is solved directly
+  /// A gathered coarsest level with more rows than this (decoupled aggregation cannot go below
+  /// about one row per rank, so on many ranks it stays large) is solved by one V-cycle of a
+  /// one-process AMG built on the gathered matrix, the same on every rank, instead of a dense
+  /// pseudo-inverse whose set-up grows with its cube.
+  std::int64_t denseCoarseRows = 500;
   int maxLevels = 16;
 };
 
@@ -57,6 +64,9 @@ class DistributedAmg final : public Preconditioner {
   void setup(const ExecSpace& exec, const CsrMatrix& A) override;
   void apply(const ExecSpace& exec, const ConstRealView& r, const RealView& z) override;
   std::string name() const override { return "distributed-amg"; }
+  /// \brief The coarsest level's gathers (one MPI_Allgatherv per V-cycle on several ranks) made
+  /// by every DistributedAmg of this process so far: a latency count of the scaling model (perf/).
+  static std::int64_t coarseGathers();
 
   const std::vector<DistributedAmgLevelInfo>& levels() const;
 

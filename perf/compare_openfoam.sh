@@ -21,8 +21,10 @@
 #    momentum solve, the final pressure solve from the last step's final-corrector change (icoFoam
 #    starts from the last values). OMP_PROC_BIND=spread OMP_PLACES=cores,
 #    OMP_NUM_THREADS = 1 or 2. Timed around steps 6..STEPS (fenced).
-# Order per repeat: OpenFOAM 1 rank, ours 1 thread, OpenFOAM 2 ranks, ours 2 threads, so slow
-# drifts in the machine load hit both sides alike. `uptime` is recorded around every run. After
+#  - Ours on 2 MPI ranks x 1 thread (perf/distributed_fluid.cpp, the same settings; the mesh cut by
+#    METIS, the pressure by CG + the distributed AMG): mpirun -np 2, steps 6..STEPS timed.
+# Order per repeat: OpenFOAM 1 rank, ours 1 thread, OpenFOAM 2 ranks, ours 2 threads, ours 2 ranks,
+# so slow drifts in the machine load hit both sides alike. `uptime` is recorded around every run. After
 # the timing runs ours runs once more per thread count with region profiling (phase fractions).
 #
 # Ghia errors of the 2D cavity (Re = 100, N = 64, 128) are taken from
@@ -41,6 +43,8 @@ repeats=${3:-3}
 build=${MFSI_BUILD:-$REPO/build}
 bench=$build/perf/bench_cavity3d
 [ -x "$bench" ] || { echo "no $bench: build target bench_cavity3d (MFSI_BUILD=...)" >&2; exit 1; }
+dist=$build/perf/perf_distributed_fluid
+[ -x "$dist" ] || { echo "no $dist: build target perf_distributed_fluid (MFSI_BUILD=...)" >&2; exit 1; }
 out_dir=$here/results
 mkdir -p "$out_dir"
 
@@ -99,6 +103,13 @@ for r in $(seq 1 "$repeats"); do
     before=$(load_note)
     ours "$np" 0 "$log"
     runs+=("ours|$np|$r|$log|$before|$(load_note)")
+    if [ "$np" = 2 ]; then
+      log=$logdir/ours-mpi.np2.run$r.log
+      before=$(load_note)
+      OMP_NUM_THREADS=1 OMP_PROC_BIND=false $MPIRUN --bind-to none -np 2 "$dist" "$n" "$steps" 5 distributed \
+        >"$log" 2>&1 || { tail -20 "$log"; exit 1; }
+      runs+=("ours-mpi|2|$r|$log|$before|$(load_note)")
+    fi
     echo "repeat $r, $np thread(s)/rank(s) done; load $(load_note)"
   done
 done
@@ -140,6 +151,14 @@ def openfoam_run(log):
             "s_per_step": (stamps[-1] - stamps[4]) / timed,
             "p_iters_per_step": sum(piters) / timed}
 
+def ours_mpi_run(log):
+    line = [l for l in open(log) if l.startswith("n=")][-1]
+    m = re.search(r"\| ([0-9.e+-]+) s/cell-step, ([0-9.]+) s/step \| pressure its/step ([0-9.]+), momentum its/step "
+                  r"([0-9.]+) .*ok=1", line)
+    assert m, (log, line)
+    return {"s_per_cell_step": float(m.group(1)), "s_per_step": float(m.group(2)),
+            "p_iters_per_step": float(m.group(3)), "u_iters_per_step": float(m.group(4))}
+
 def ours_run(log):
     b = json.load(open(log))["benchmarks"][0]
     assert "error_message" not in b, b
@@ -154,18 +173,20 @@ for spec in sys.argv[8:]:
     if who == "profile":
         profiles[np_] = dict(ours_run(log), log=log, load_before=before, load_after=after)
         continue
-    res = openfoam_run(log) if who == "openfoam" else ours_run(log)
+    res = {"openfoam": openfoam_run, "ours": ours_run, "ours-mpi": ours_mpi_run}[who](log)
     runs.append(dict(res, code=who, threads_or_ranks=int(np_), run=int(r), log=log, load_before=before, load_after=after))
 
 med, best = {}, {}
-for who in ("openfoam", "ours"):
+for who in ("openfoam", "ours", "ours-mpi"):
     for np_ in (1, 2):
         rs = [x for x in runs if x["code"] == who and x["threads_or_ranks"] == np_]
+        if not rs: continue
         keys = [k for k in rs[0] if isinstance(rs[0][k], float) and k != "run"]
         med.setdefault(who, {})[str(np_)] = {k: statistics.median(x[k] for x in rs) for k in keys}
         best.setdefault(who, {})[str(np_)] = {k: min(x[k] for x in rs) for k in keys}
 ratio = {np_: med["openfoam"][np_]["s_per_cell_step"] / med["ours"][np_]["s_per_cell_step"] for np_ in ("1", "2")}
 ratio_min = {np_: best["openfoam"][np_]["s_per_cell_step"] / best["ours"][np_]["s_per_cell_step"] for np_ in ("1", "2")}
+ratio_mpi = med["openfoam"]["2"]["s_per_cell_step"] / med["ours-mpi"]["2"]["s_per_cell_step"]
 
 ghia = {}
 if os.path.exists(of_ghia):
@@ -187,7 +208,8 @@ doc = {"what": "3D lid-driven cube cavity Re=100, ours (bench_cavity3d) vs OpenF
                         "OMP_PROC_BIND=spread OMP_PLACES=cores",
        "load_start": os.environ["LOAD_START"], "load_end": os.environ["LOAD_END"],
        "median": med, "min": best,
-       "speedup_openfoam_over_ours_median": ratio, "speedup_openfoam_over_ours_min": ratio_min,
+       "speedup_openfoam_over_ours_median": ratio,
+       "speedup_openfoam_2ranks_over_ours_2ranks_median": ratio_mpi, "speedup_openfoam_over_ours_min": ratio_min,
        "ours_profile_fractions": profiles,
        "ghia_2d_max_abs_err": ghia,
        "runs": runs}
@@ -202,6 +224,10 @@ for np_ in ("1", "2"):
         np_, o["s_per_cell_step"], best["openfoam"][np_]["s_per_cell_step"], m["s_per_cell_step"],
         best["ours"][np_]["s_per_cell_step"], ratio[np_], ratio_min[np_], o["p_iters_per_step"], m["p_iters_per_step"],
         o["cpu_s_per_cell_step"]))
+o, m = med["openfoam"]["2"], med["ours-mpi"]["2"]
+print("| 2 MPI ranks both (ours decomposed, distributed AMG) | %.3e | %.3e (min %.3e) | %.2f | %.1f | %.1f | |" % (
+    o["s_per_cell_step"], m["s_per_cell_step"], best["ours-mpi"]["2"]["s_per_cell_step"], ratio_mpi,
+    o["p_iters_per_step"], m["p_iters_per_step"]))
 print("\n(N = %d, %d cells, dt = %g, steps 6..%d timed, medians over %d runs; OpenFOAM p iterations: GAMG "
       "cycles, ours: AMG-CG iterations, both summed over the 2 correctors)" % (n, cells, dt, steps, repeats))
 print("load (uptime) at start: %s; at end: %s" % (os.environ["LOAD_START"], os.environ["LOAD_END"]))

@@ -12,6 +12,8 @@
 #include "core/parallel/LocalMesh.hpp"
 #include "core/parallel/Partition.hpp"
 #include "fluid/FluidSolver.hpp"
+#include "kernels/Blas.hpp"
+#include "kernels/DistributedAmg.hpp"
 
 #include <mpi.h>
 
@@ -84,6 +86,9 @@ int main(int argc, char** argv) {
     for (int s = 0; s < untimed; ++s) ok = fluid.solveStep(s * dt, dt).ok && ok;
     const Halo* halo = fluid.cellHalo();
     const long long bytes0 = halo ? halo->bytesSent() : 0, messages0 = halo ? halo->messagesSent() : 0;
+    const long long haloBytes0 = Halo::allBytesSent(), haloMessages0 = Halo::allMessagesSent(),
+                    exchanges0 = Halo::allExchanges(), reductions0 = SolverComm::reductions(),
+                    gathers0 = DistributedAmg::coarseGathers();
     Kokkos::fence();
     MPI_Barrier(MPI_COMM_WORLD);
     const double t0 = MPI_Wtime();
@@ -99,6 +104,13 @@ int main(int argc, char** argv) {
     const double wall = MPI_Wtime() - t0;
     const int timed = steps - untimed;
     long long bytes = (halo ? halo->bytesSent() : 0) - bytes0, messages = (halo ? halo->messagesSent() : 0) - messages0;
+    // Every halo of the process (cells and the AMG's levels), the collectives and the AMG's
+    // coarse gathers: the counts the scaling model in perf/RESULTS.md is built from.
+    long long totals[3] = {Halo::allBytesSent() - haloBytes0, Halo::allMessagesSent() - haloMessages0, 0};
+    long long allTotals[3] = {0, 0, 0};
+    MPI_Reduce(totals, allTotals, 3, MPI_LONG_LONG, MPI_SUM, 0, MPI_COMM_WORLD);
+    const long long exchanges = Halo::allExchanges() - exchanges0, reductions = SolverComm::reductions() - reductions0,
+                    gathers = DistributedAmg::coarseGathers() - gathers0;
     long long allBytes = 0, allMessages = 0;
     MPI_Reduce(&bytes, &allBytes, 1, MPI_LONG_LONG, MPI_SUM, 0, MPI_COMM_WORLD);
     MPI_Reduce(&messages, &allMessages, 1, MPI_LONG_LONG, MPI_SUM, 0, MPI_COMM_WORLD);
@@ -108,11 +120,13 @@ int main(int argc, char** argv) {
     if (rank == 0) {
       std::printf("n=%d^3 cells=%.0f mode=%s ranks=%d threads=%d edgecut=%lld steps=%d | %.4e s/cell-step, "
                   "%.3f s/step | pressure its/step %.2f, momentum its/step %.2f | cell halo per step (all ranks): "
-                  "%.0f messages, %.0f bytes | ok=%d\n",
+                  "%.0f messages, %.0f bytes | all halos per step (all ranks): %.0f messages, %.0f bytes; per rank "
+                  "%.1f exchanges, %.1f reductions, %.1f coarse gathers | ok=%d\n",
                   n, cells, serial ? "serial" : "distributed", ranks, Kokkos::DefaultExecutionSpace().concurrency(),
                   static_cast<long long>(part.edgeCut), timed, wall / (timed * cells), wall / timed,
                   double(pIts) / timed, double(uIts) / timed, double(allMessages) / timed, double(allBytes) / timed,
-                  allOk);
+                  double(allTotals[1]) / timed, double(allTotals[0]) / timed, double(exchanges) / timed,
+                  double(reductions) / timed, double(gathers) / timed, allOk);
     }
     status = allOk ? 0 : 1;
   }

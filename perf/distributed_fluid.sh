@@ -41,7 +41,7 @@ import re, sys, statistics
 rows = {}
 for line in open(sys.argv[1]):
     m = re.match(r"n=(\d+)\^3 .* mode=(\w+) ranks=(\d) threads=(\d) edgecut=(\d+).*\| ([0-9.e+-]+) s/cell-step.*"
-                 r"pressure its/step ([0-9.]+).*: ([0-9.]+) messages, ([0-9.]+) bytes", line)
+                 r"pressure its/step ([0-9.]+).*cell halo per step \(all ranks\): ([0-9.]+) messages, ([0-9.]+) bytes", line)
     if not m: continue
     n, mode, r, t, cut, s, pits, msg, byt = m.groups()
     rows.setdefault((int(n), mode, int(r), int(t)), []).append((float(s), float(pits), int(cut), float(msg), float(byt)))

@@ -6,6 +6,7 @@ namespace mfsi {
 
 namespace {
 constexpr int kHaloTag = 7411;
+std::int64_t gBytes = 0, gMessages = 0, gExchanges = 0;
 static_assert(sizeof(real) == sizeof(double), "the halo sends reals as MPI_DOUBLE");
 }  // namespace
 
@@ -41,6 +42,10 @@ Halo::~Halo() {
     for (auto& r : list)
       if (r != MPI_REQUEST_NULL) MPI_Request_free(&r);
 }
+
+std::int64_t Halo::allBytesSent() { return gBytes; }
+std::int64_t Halo::allMessagesSent() { return gMessages; }
+std::int64_t Halo::allExchanges() { return gExchanges; }
 
 std::int64_t Halo::sendBytes(int components) const {
   return static_cast<std::int64_t>(sendOffsets_.empty() ? 0 : sendOffsets_.back()) * components *
@@ -92,6 +97,9 @@ void Halo::transfer(const ExecSpace& exec, int components) const {
   finish(components);
   bytesSent_ += sendBytes(components);
   messagesSent_ += sendMessages();
+  gBytes += sendBytes(components);
+  gMessages += sendMessages();
+  ++gExchanges;
   Kokkos::deep_copy(exec, recvBuf_, recvHost_);
 }
 

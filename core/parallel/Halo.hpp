@@ -60,6 +60,11 @@ class Halo {
   /// \brief Bytes and messages this rank has sent in all exchanges so far.
   std::int64_t bytesSent() const { return bytesSent_; }
   std::int64_t messagesSent() const { return messagesSent_; }
+  /// \brief The same summed over every halo of this process (the fluid's cells, the AMG's
+  /// levels), and the number of exchanges made.
+  static std::int64_t allBytesSent();
+  static std::int64_t allMessagesSent();
+  static std::int64_t allExchanges();
 
  private:
   void start(int components) const;

@@ -28,3 +28,10 @@ TEST(DistributedAmg, ARandomPartitionStillConverges) {
   const HexMeshInput in = box({12, 12, 12});
   test::checkDistributedAmg(in, test::randomPartition(in.cells.size(), 2));
 }
+
+TEST(DistributedAmg, ALargeGatheredCoarseLevelIsSolvedByItsOwnAmg) {
+  const HexMeshInput in = box({24, 24, 24});
+  PartitionOptions opt;
+  opt.parts = 2;
+  test::checkGatheredCoarseAmg(in, partitionCells(in, opt).cellRank);
+}

@@ -14,11 +14,12 @@ struct AmgSolve {
   std::vector<DistributedAmgLevelInfo> levels;
 };
 
-inline AmgSolve solveWithAmg(MPI_Comm comm, const HexMesh& mesh, const HaloPlan& plan, const Halo* halo) {
+inline AmgSolve solveWithAmg(MPI_Comm comm, const HexMesh& mesh, const HaloPlan& plan, const Halo* halo,
+                             const DistributedAmgOptions& options = {}) {
   RealView b;
   const CellCsr csr = laplacian(mesh, "xmin", b);
   auto gid = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), mesh.cellGlobalIds());
-  DistributedAmg amg(comm, plan, std::vector<gid_t>(gid.data(), gid.data() + gid.extent(0)));
+  DistributedAmg amg(comm, plan, std::vector<gid_t>(gid.data(), gid.data() + gid.extent(0)), options);
   const ExecSpace exec;
   amg.setup(exec, csr.matrix);
   KrylovOptions opt;
@@ -36,9 +37,10 @@ inline AmgSolve solveWithAmg(MPI_Comm comm, const HexMesh& mesh, const HaloPlan&
   return s;
 }
 
-/// AMG-CG on the whole mesh (one process) and on every rank's part; returns the two iteration
-/// counts after checking the answers agree to 1e-9.
-inline std::pair<int, int> checkDistributedAmg(const HexMeshInput& in, const std::vector<int>& cellRank) {
+/// AMG-CG on the whole mesh (one process, default options) and on every rank's part (`options`);
+/// returns the two iteration counts after checking the answers agree to 1e-9.
+inline std::pair<int, int> checkDistributedAmg(const HexMeshInput& in, const std::vector<int>& cellRank,
+                                               const DistributedAmgOptions& options = {}) {
   int ranks = 1, rank = 0;
   MPI_Comm_size(MPI_COMM_WORLD, &ranks);
   MPI_Comm_rank(MPI_COMM_WORLD, &rank);
@@ -51,7 +53,11 @@ inline std::pair<int, int> checkDistributedAmg(const HexMeshInput& in, const std
   const LocalMeshPart part = localMeshPart(global, cellRank, ranks, rank);
   const HexMesh local = buildHexMesh(part.input);
   const Halo halo(MPI_COMM_WORLD, part.cells);
-  const AmgSolve dist = solveWithAmg(MPI_COMM_WORLD, local, part.cells, &halo);
+  const AmgSolve dist = solveWithAmg(MPI_COMM_WORLD, local, part.cells, &halo, options);
+  if (options.denseCoarseRows < DistributedAmgOptions{}.denseCoarseRows) {
+    // The case asks for a gathered level solved by its one-process AMG: it must get one.
+    EXPECT_GT(dist.levels.back().rows, options.denseCoarseRows);
+  }
   EXPECT_TRUE(dist.solve.converged);
   double worst = 0;
   for (const auto& [g, v] : dist.solve.x)
@@ -68,6 +74,17 @@ inline std::pair<int, int> checkDistributedAmg(const HexMeshInput& in, const std
     std::printf("\n");
   }
   return {one.solve.iterations, dist.solve.iterations};
+}
+
+/// The coarsest level gathered early (at most 5,000 rows) and solved by a one-process AMG of the
+/// gathered matrix (above 100 rows), as on many ranks: the answer of the one-process dense-coarse
+/// hierarchy, within two iterations of it.
+inline void checkGatheredCoarseAmg(const HexMeshInput& in, const std::vector<int>& cellRank) {
+  DistributedAmgOptions o;
+  o.coarseSize = 5000;
+  o.denseCoarseRows = 100;
+  const auto [one, many] = checkDistributedAmg(in, cellRank, o);
+  EXPECT_LE(many, one + 2);
 }
 
 }  // namespace mfsi::test
