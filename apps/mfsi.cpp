@@ -25,6 +25,7 @@
 #include "coupling/Simulation.hpp"
 #include "core/Interrupt.hpp"
 #include "core/RunLog.hpp"
+#include "core/parallel/FailureAgreement.hpp"
 
 #include <CLI/CLI.hpp>
 #include <mpi.h>
@@ -39,6 +40,9 @@ namespace fs = std::filesystem;
 namespace {
 
 constexpr const char* kDefaultScene = "membrane-channel";
+/// How long a rank that failed waits for the others to join the outcome agreement before it
+/// concludes they are stuck in a collective and aborts the job.
+constexpr double kOutcomeTimeoutSeconds = 10.0;
 
 std::vector<fs::path> caseDirs() {
   std::vector<fs::path> dirs;
@@ -212,12 +216,17 @@ int commandRun(std::string sceneArg, const std::vector<std::string>& sets, std::
   if (summary.ranks > 1) MPI_Bcast(&prepared, 1, MPI_INT, 0, MPI_COMM_WORLD);  // every rank stops, or none
   if (!prepared) return 2;
   // On several ranks the solvers agree on every global decision (residuals, divergence, input
-  // checks), so those errors arise on every rank at once and rank 0 reports them. An error of one
-  // rank alone (its files, an internal failure) leaves the others waiting in a collective: that
-  // rank reports it, rank 0 writes the summary if it is the one, and MPI_Abort stops them all.
-  bool abortOthers = false;
+  // checks), so those errors arise on every rank at once. At the end every rank joins an
+  // agreement on the outcome (core/parallel/FailureAgreement): rank 0 then prints the one message
+  // (the lowest failed rank's) and writes the one summary. A rank that failed alone while the
+  // others wait in a collective it left times out there: it prints, writes the summary itself
+  // and MPI_Abort stops them all.
+  MPI_Comm outcomeComm = MPI_COMM_NULL;
+  if (summary.ranks > 1) MPI_Comm_dup(MPI_COMM_WORLD, &outcomeComm);
+  std::string reportLine;
   auto report = [&](const std::string& line) {
-    if (rank == 0 || abortOthers) std::cerr << line << "\n";
+    reportLine = line;
+    if (summary.ranks == 1) std::cerr << line << "\n";
   };
   try {
     const fs::path file = resolveScene(sceneArg);
@@ -280,13 +289,12 @@ int commandRun(std::string sceneArg, const std::vector<std::string>& sets, std::
   } catch (const mfsi::OutputError& e) {
     summary.status = "error";
     summary.error = std::string("output: ") + e.what();
-    abortOthers = summary.ranks > 1;
     report(std::string("error: results not saved: ") + e.what());
     code = 4;
   } catch (const std::exception& e) {
     summary.status = "error";
-    summary.error = std::string("internal error: ") + e.what();
-    abortOthers = summary.ranks > 1;
+    summary.error = std::string("internal error") + (summary.ranks > 1 ? " on rank " + std::to_string(rank) : "") +
+                    ": " + e.what();
     report(std::string("internal error") + (summary.ranks > 1 ? " on rank " + std::to_string(rank) : "") + ": " +
            e.what());
     code = 1;
@@ -297,7 +305,26 @@ int commandRun(std::string sceneArg, const std::vector<std::string>& sets, std::
     summary.simTime = sim->completedTime();
   }
   summary.wallSeconds = mfsi::wallSeconds() - t0;
-  if (rank == 0) {
+  bool writer = rank == 0, abortAll = false;
+  if (summary.ranks > 1) {
+    const mfsi::FailureAgreement agreed =
+        mfsi::agreeOnOutcome(outcomeComm, {code, summary.status, summary.error, reportLine}, kOutcomeTimeoutSeconds);
+    if (!agreed.complete) {
+      // The others are stuck in a collective this rank left: it speaks for the run.
+      std::cerr << reportLine << (reportLine.find("rank ") == std::string::npos ? " (rank " + std::to_string(rank) + ")" : "")
+                << "\n";
+      writer = abortAll = true;
+    } else {
+      if (agreed.firstFailed >= 0) {
+        code = agreed.outcome.code;
+        summary.status = agreed.outcome.status;
+        summary.error = agreed.outcome.error;
+        if (rank == 0) std::cerr << agreed.outcome.message << "\n";
+      }
+      MPI_Comm_free(&outcomeComm);
+    }
+  }
+  if (writer) {
     try {
       mfsi::writeSummary(out, summary);
       std::cout << (code == 0                           ? "done"
@@ -315,7 +342,7 @@ int commandRun(std::string sceneArg, const std::vector<std::string>& sets, std::
       if (code == 0) code = 4;
     }
   }
-  if (abortOthers) MPI_Abort(MPI_COMM_WORLD, code);
+  if (abortAll) MPI_Abort(MPI_COMM_WORLD, code);
   return code;
 }
 

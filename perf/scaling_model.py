@@ -40,13 +40,15 @@ import sys
 def measured(path):
     rows = []
     for line in open(path):
+        counters_only = line.startswith("# counters: ")  # timings not to be used, counts valid
+        line = line[len("# counters: "):] if counters_only else line
         m = re.match(r"n=(\d+)\^3 cells=(\d+) mode=(\w+) ranks=(\d) threads=(\d) edgecut=(\d+).*\| ([0-9.e+-]+) "
                      r"s/cell-step.*pressure its/step ([0-9.]+)", line)
         if not m:
             continue
         n, cells, mode, ranks, threads, cut, s, its = m.groups()
         row = dict(n=int(n), cells=int(cells), mode=mode, ranks=int(ranks), threads=int(threads), cut=int(cut),
-                   s=float(s), its=float(its))
+                   s=None if counters_only else float(s), its=float(its))
         c = re.search(r"all halos per step \(all ranks\): ([0-9.]+) messages, ([0-9.]+) bytes; per rank ([0-9.]+) "
                       r"exchanges, ([0-9.]+) reductions, ([0-9.]+) coarse gathers", line)
         if c:
@@ -76,7 +78,7 @@ def main():
     dist = [r for r in rows if r["mode"] == "distributed"]
     big = max(r["n"] for r in dist)
     small = min(r["n"] for r in dist)
-    one = [r for r in dist if r["n"] == big and r["ranks"] == 1 and r["threads"] == 1]
+    one = [r for r in dist if r["n"] == big and r["ranks"] == 1 and r["threads"] == 1 and r["s"] is not None]
     two = [r for r in dist if r["n"] == big and r["ranks"] == 2 and r["threads"] == 1 and "exchanges" in r]
     if not one or not two:
         sys.exit("%s: no %d^3 runs of 1 and 2 ranks x 1 thread with counters (run perf/distributed_fluid.sh)"

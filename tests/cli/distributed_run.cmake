@@ -90,3 +90,19 @@ if(EXISTS ${WORK}/fc2/summary.json)
     message(SEND_ERROR "flexible-cavity on 2 ranks: summary status ${status}")
   endif()
 endif()
+
+# A divergence on several ranks (decided by a global maximum, so on every rank at once): one
+# message, exit 3, one summary.json with status "diverged" and the rank count.
+execute_process(COMMAND ${MPIEXEC} --allow-run-as-root --oversubscribe -np 2 ${MFSI} run ${scene}
+  --set fluid.divergenceVelocityFactor=0.2 --out ${WORK}/dv2 RESULT_VARIABLE rc OUTPUT_VARIABLE o ERROR_VARIABLE e)
+string(REGEX MATCHALL "diverged: fluid: runaway growth" lines "${e}")
+list(LENGTH lines nl)
+if(NOT rc EQUAL 3 OR NOT nl EQUAL 1)
+  message(SEND_ERROR "diverging cavity on 2 ranks: exit ${rc}, ${nl} messages:\n${e}")
+endif()
+file(READ ${WORK}/dv2/summary.json s)
+string(JSON status GET "${s}" status)
+string(JSON ranks GET "${s}" ranks)
+if(NOT status STREQUAL "diverged" OR NOT ranks EQUAL 2)
+  message(SEND_ERROR "diverging cavity on 2 ranks: summary status ${status}, ranks ${ranks}")
+endif()
