@@ -295,8 +295,7 @@ int commandRun(std::string sceneArg, const std::vector<std::string>& sets, std::
     summary.status = "error";
     summary.error = std::string("internal error") + (summary.ranks > 1 ? " on rank " + std::to_string(rank) : "") +
                     ": " + e.what();
-    report(std::string("internal error") + (summary.ranks > 1 ? " on rank " + std::to_string(rank) : "") + ": " +
-           e.what());
+    report(summary.error);
     code = 1;
   }
   if (sim) {

@@ -146,13 +146,10 @@ void denseRows(const ExecSpace& exec, const Kokkos::View<double**, MemSpace>& in
       });
 }
 
-}  // namespace
-
 /// Coarsest-level gathers made by every DistributedAmg of this process (DistributedAmg::coarseGathers).
-std::int64_t& coarseGatherCount() {
-  static std::int64_t count = 0;
-  return count;
-}
+std::int64_t gCoarseGathers = 0;
+
+}  // namespace
 
 struct DistributedAmg::Impl {
   struct Level {
@@ -401,41 +398,10 @@ struct DistributedAmg::Impl {
       allCols = colIds;
       allVals = vals;
     }
-    // Gathered order: rank by rank, each rank's rows in its order.
+    // The gathered level as one process's matrix, rows and columns in gathered order (rank by
+    // rank, each rank's rows in its order).
     std::map<long long, int> where;
     for (int k = 0; k < total; ++k) where[allRows[k]] = k;
-    coarseAll = RealView("mfsi::kernels::damg::coarseAll", total);
-    coarseAmg.reset();
-    if (ranks > 1 && total > opt.denseCoarseRows) {
-      gatheredAmg(exec, total, allRows, allLen, allCols, allVals, where);
-      return;
-    }
-    Eigen::MatrixXd M = Eigen::MatrixXd::Zero(total, total);
-    for (int k = 0, p = 0; k < total; ++k)
-      for (int e = 0; e < allLen[k]; ++e, ++p) {
-        const auto it = where.find(allCols[p]);
-        MFSI_CHECK(it != where.end(), "distributed AMG: coarsest column " << allCols[p] << " has no row");
-        M(k, it->second) += allVals[p];
-      }
-    const Eigen::MatrixXd S = 0.5 * (M + M.transpose());
-    Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eig(S);
-    const Eigen::VectorXd lam = eig.eigenvalues();
-    const double cut = 1e-10 * lam.cwiseAbs().maxCoeff();
-    Eigen::VectorXd inv(total);
-    for (int k = 0; k < total; ++k) inv(k) = std::abs(lam(k)) > cut ? 1.0 / lam(k) : 0.0;
-    const Eigen::MatrixXd Pinv = eig.eigenvectors() * inv.asDiagonal() * eig.eigenvectors().transpose();
-    coarseInv = Kokkos::View<double**, MemSpace>("mfsi::kernels::damg::coarseInverse", n, total);
-    auto h = Kokkos::create_mirror_view(coarseInv);
-    for (lid_t i = 0; i < n; ++i)
-      for (int k = 0; k < total; ++k) h(i, k) = Pinv(coarseDispls[me] + i, k);
-    Kokkos::deep_copy(coarseInv, h);
-  }
-
-  /// The gathered level as one process's matrix (every row owned, no ghosts) and its AMG, whose
-  /// own coarsest level is dense.
-  void gatheredAmg(const ExecSpace& exec, int total, const std::vector<long long>& allRows,
-                   const std::vector<int>& allLen, const std::vector<long long>& allCols,
-                   const std::vector<double>& allVals, const std::map<long long, int>& where) {
     HostCsr g;
     g.nRows = g.nCols = total;
     for (int k = 0, p = 0; k < total; ++k) {
@@ -451,6 +417,33 @@ struct DistributedAmg::Impl {
       }
       g.ptr.push_back(static_cast<lid_t>(g.col.size()));
     }
+    coarseAll = RealView("mfsi::kernels::damg::coarseAll", total);
+    coarseAmg.reset();
+    if (ranks > 1 && total > opt.denseCoarseRows) {
+      gatheredAmg(exec, g, allRows);
+      return;
+    }
+    Eigen::MatrixXd M = Eigen::MatrixXd::Zero(total, total);
+    for (int k = 0; k < total; ++k)
+      for (lid_t p = g.ptr[k]; p < g.ptr[k + 1]; ++p) M(k, g.col[p]) = g.val[p];
+    const Eigen::MatrixXd S = 0.5 * (M + M.transpose());
+    Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eig(S);
+    const Eigen::VectorXd lam = eig.eigenvalues();
+    const double cut = 1e-10 * lam.cwiseAbs().maxCoeff();
+    Eigen::VectorXd inv(total);
+    for (int k = 0; k < total; ++k) inv(k) = std::abs(lam(k)) > cut ? 1.0 / lam(k) : 0.0;
+    const Eigen::MatrixXd Pinv = eig.eigenvectors() * inv.asDiagonal() * eig.eigenvectors().transpose();
+    coarseInv = Kokkos::View<double**, MemSpace>("mfsi::kernels::damg::coarseInverse", n, total);
+    auto h = Kokkos::create_mirror_view(coarseInv);
+    for (lid_t i = 0; i < n; ++i)
+      for (int k = 0; k < total; ++k) h(i, k) = Pinv(coarseDispls[me] + i, k);
+    Kokkos::deep_copy(coarseInv, h);
+  }
+
+  /// The gathered level `g` (every row owned, no ghosts; global ids `allRows`) and its AMG, whose
+  /// own coarsest level is dense.
+  void gatheredAmg(const ExecSpace& exec, const HostCsr& g, const std::vector<long long>& allRows) {
+    const int total = g.nRows;
     HaloPlan plan;
     plan.nOwned = plan.nLocal = total;
     plan.sendOffsets = plan.recvOffsets = {0};
@@ -470,7 +463,7 @@ struct DistributedAmg::Impl {
       auto hb = Kokkos::create_mirror_view_and_copy(HostSpace(), Kokkos::subview(L.b, std::make_pair(0, n)));
       auto ha = Kokkos::create_mirror_view(coarseAll);
       MPI_Allgatherv(hb.data(), n, MPI_DOUBLE, ha.data(), coarseCounts.data(), coarseDispls.data(), MPI_DOUBLE, comm);
-      ++coarseGatherCount();
+      ++gCoarseGathers;
       Kokkos::deep_copy(exec, coarseAll, ha);
     }
     if (coarseAmg) {
@@ -541,7 +534,7 @@ DistributedAmg::DistributedAmg(MPI_Comm comm, const HaloPlan& plan, std::vector<
 
 DistributedAmg::~DistributedAmg() = default;
 
-std::int64_t DistributedAmg::coarseGathers() { return coarseGatherCount(); }
+std::int64_t DistributedAmg::coarseGathers() { return gCoarseGathers; }
 
 const std::vector<DistributedAmgLevelInfo>& DistributedAmg::levels() const { return impl_->info; }
 

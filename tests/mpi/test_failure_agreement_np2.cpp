@@ -20,38 +20,33 @@ struct Comm {
   }
   ~Comm() { MPI_Comm_free(&comm); }
 };
+
+/// The agreement completed and every rank holds rank `first`'s outcome `expected`.
+void expectAgreed(const FailureAgreement& a, int first, const RankOutcome& expected) {
+  EXPECT_TRUE(a.complete);
+  EXPECT_EQ(a.firstFailed, first);
+  EXPECT_EQ(a.outcome.code, expected.code);
+  EXPECT_EQ(a.outcome.status, expected.status);
+  EXPECT_EQ(a.outcome.error, expected.error);
+  EXPECT_EQ(a.outcome.message, expected.message);
+}
 }  // namespace
 
 TEST(FailureAgreement, SuccessEverywhereIsNoFailure) {
   Comm c;
-  const FailureAgreement a = agreeOnOutcome(c.comm, {}, 1.0);
-  EXPECT_TRUE(a.complete);
-  EXPECT_EQ(a.firstFailed, -1);
-  EXPECT_EQ(a.outcome.code, 0);
+  expectAgreed(agreeOnOutcome(c.comm, {}, 1.0), -1, {});
 }
 
 TEST(FailureAgreement, TheSameFailureOnEveryRankIsRankZeros) {
   Comm c;
   const RankOutcome mine{3, "diverged", "at t = 0.5", "diverged at t = 0.5 (rank " + std::to_string(c.rank) + ")"};
-  const FailureAgreement a = agreeOnOutcome(c.comm, mine, 10.0);
-  EXPECT_TRUE(a.complete);
-  EXPECT_EQ(a.firstFailed, 0);
-  EXPECT_EQ(a.outcome.code, 3);
-  EXPECT_EQ(a.outcome.status, "diverged");
-  EXPECT_EQ(a.outcome.error, "at t = 0.5");
-  EXPECT_EQ(a.outcome.message, "diverged at t = 0.5 (rank 0)");
+  expectAgreed(agreeOnOutcome(c.comm, mine, 10.0), 0, {3, "diverged", "at t = 0.5", "diverged at t = 0.5 (rank 0)"});
 }
 
 TEST(FailureAgreement, OneRanksFailureReachesTheOther) {
   Comm c;
-  const RankOutcome mine = c.rank == 1 ? RankOutcome{1, "error", "out of memory", "internal error on rank 1: out of memory"} : RankOutcome{};
-  const FailureAgreement a = agreeOnOutcome(c.comm, mine, 10.0);
-  EXPECT_TRUE(a.complete);
-  EXPECT_EQ(a.firstFailed, 1);
-  EXPECT_EQ(a.outcome.code, 1);
-  EXPECT_EQ(a.outcome.status, "error");
-  EXPECT_EQ(a.outcome.error, "out of memory");
-  EXPECT_EQ(a.outcome.message, "internal error on rank 1: out of memory");
+  const RankOutcome failed{1, "error", "out of memory", "internal error on rank 1: out of memory"};
+  expectAgreed(agreeOnOutcome(c.comm, c.rank == 1 ? failed : RankOutcome{}, 10.0), 1, failed);
 }
 
 TEST(FailureAgreement, AFailedRankDoesNotWaitForOneThatIsElsewhere) {
