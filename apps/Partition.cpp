@@ -16,36 +16,6 @@
 
 namespace fs = std::filesystem;
 
-namespace {
-
-/// The cells along every membrane's surface: the owners of its baffle's faces (both sides) or of
-/// its wall patch's faces, one group per membrane.
-std::vector<std::vector<mfsi::lid_t>> membraneCellGroups(const mfsi::SceneConfig& cfg, const mfsi::HexMesh& mesh) {
-  std::vector<std::vector<mfsi::lid_t>> groups;
-  if (!cfg.has("membranes")) return groups;
-  auto owner = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), mesh.faceOwner());
-  for (std::size_t i = 0; i < cfg.size("membranes"); ++i) {
-    const std::string m = "membranes." + std::to_string(i) + ".mesh.";
-    std::vector<std::string> patches;
-    if (cfg.has(m + "baffles.patch")) {
-      const std::string b = cfg.get<std::string>(m + "baffles.patch");
-      patches = {b + "_master", b + "_slave"};
-    } else if (cfg.has(m + "boundaryPatch.patch")) {
-      patches = {cfg.get<std::string>(m + "boundaryPatch.patch")};
-    }
-    std::vector<mfsi::lid_t> cells;
-    for (const auto& name : patches) {
-      const int p = mesh.findPatch(name);
-      if (p < 0) continue;  // the scene check names it
-      const auto& patch = mesh.patches()[p];
-      for (mfsi::lid_t f = patch.start; f < patch.start + patch.size; ++f) cells.push_back(owner(f));
-    }
-    if (!cells.empty()) groups.push_back(std::move(cells));
-  }
-  return groups;
-}
-
-}  // namespace
 
 int commandPartition(const std::string& scene, const std::vector<std::string>& sets, int ranks, std::string out) {
   mfsi::Partition part;
@@ -59,7 +29,7 @@ int commandPartition(const std::string& scene, const std::vector<std::string>& s
     const mfsi::HexMesh mesh = mfsi::buildMesh(cfg.child("mesh"));
     mfsi::PartitionOptions opt;
     opt.parts = ranks;
-    opt.keepTogether = membraneCellGroups(cfg, mesh);
+    opt.keepTogether = mfsi::membraneCellGroups(cfg, mesh);
     part = mfsi::partitionGraph(mfsi::cellDualGraph(mesh), opt);
     for (int r = 0; r < ranks; ++r) parts.push_back(mfsi::localMeshPart(mesh, part.cellRank, ranks, r));
   } catch (const mfsi::InputError& e) {

@@ -169,7 +169,7 @@ void MembraneModule::addMetrics(std::map<std::string, double>& metrics) const {
 ModuleEntry membraneModuleEntry() {
   return {"membranes", &membraneSchema, [](const SceneConfig& section, SimulationContext& ctx) {
             std::vector<std::unique_ptr<Module>> v;
-            for (const auto& panel : readMembraneOptions(section, ctx.mesh)) v.push_back(std::make_unique<MembraneModule>(panel));
+            for (const auto& panel : readMembraneOptions(section, ctx.wholeMesh != nullptr ? ctx.wholeMesh : ctx.mesh)) v.push_back(std::make_unique<MembraneModule>(panel));
             return v;
           }};
 }

@@ -3,6 +3,7 @@
 #include "core/Interrupt.hpp"
 #include "core/MeshConfig.hpp"
 #include "core/io/HostCopy.hpp"
+#include "core/parallel/Gather.hpp"
 #include "core/parallel/LocalMesh.hpp"
 #include "core/parallel/Partition.hpp"
 
@@ -109,6 +110,7 @@ Simulation::Simulation(const SceneConfig& scene) {
   SimulationContext ctx;
   if (hasMesh_) {
     ctx.mesh = ranks_ > 1 ? &localMesh_ : &mesh_;
+    ctx.wholeMesh = &mesh_;
     ctx.geometry = ranks_ > 1 ? &localGeometry_ : &geometry_;
     if (ranks_ > 1) ctx.domain = &domain_;
   }
@@ -128,20 +130,43 @@ Simulation::Simulation(const SceneConfig& scene) {
     throw InputError(scene.where(), "the scene names nothing to simulate: give at least a 'mesh' or a physics section");
 }
 
+std::vector<std::vector<lid_t>> membraneCellGroups(const SceneConfig& scene, const HexMesh& mesh) {
+  std::vector<std::vector<lid_t>> groups;
+  if (!scene.has("membranes")) return groups;
+  auto owner = Kokkos::create_mirror_view_and_copy(HostSpace(), mesh.faceOwner());
+  for (std::size_t i = 0; i < scene.size("membranes"); ++i) {
+    const std::string m = "membranes." + std::to_string(i) + ".mesh.";
+    std::vector<std::string> patches;
+    if (scene.has(m + "baffles.patch")) {
+      const std::string b = scene.get<std::string>(m + "baffles.patch");
+      patches = {b + "_master", b + "_slave"};
+    } else if (scene.has(m + "boundaryPatch.patch")) {
+      patches = {scene.get<std::string>(m + "boundaryPatch.patch")};
+    }
+    std::vector<lid_t> cells;
+    for (const auto& name : patches) {
+      const int p = mesh.findPatch(name);
+      if (p < 0) continue;  // the membrane's set-up names it
+      const auto& patch = mesh.patches()[p];
+      for (lid_t f = patch.start; f < patch.start + patch.size; ++f) cells.push_back(owner(f));
+    }
+    if (!cells.empty()) groups.push_back(std::move(cells));
+  }
+  return groups;
+}
+
 void Simulation::decompose(const SceneConfig& scene) {
-  // What runs on several ranks today: a fluid on the scene mesh, its field output and reports.
-  // The structure and the coupling run on one rank; so do checkpoints and restarts.
+  // What runs on several ranks today: the fluid on the parts of the scene mesh, membranes cut from
+  // it and rigid bodies (each solved by every rank on the same gathered loads), the coupling and
+  // the mesh motion, the field output and reports. Checkpoints and restarts run on one rank.
   const std::string how = " (run it on one rank: without mpirun, or mpirun -np 1; threads: --threads)";
   if (!hasMesh_) throw InputError(scene.where(), "a scene without a mesh runs on one rank" + how);
-  for (const auto& entry : moduleCatalogue())
-    if (entry.section != "fluid" && scene.has(entry.section))
-      throw InputError(scene.where(entry.section),
-                       "'" + entry.section + "' does not run on several ranks yet; a scene runs its fluid alone there" + how);
   if (checkpoint_.everySteps > 0 || checkpoint_.wallSeconds > 0 || checkpoint_.final)
     throw InputError(scene.where("output.checkpoint"), "checkpoints are not written on several ranks yet" + how);
   ScopedTimer t(timers_, "decompose");
   PartitionOptions opt;
   opt.parts = ranks_;
+  opt.keepTogether = membraneCellGroups(scene, mesh_);
   const Partition part = partitionGraph(cellDualGraph(mesh_), opt);
   const LocalMeshPart lp = localMeshPart(mesh_, part.cellRank, ranks_, rank_);
   localMesh_ = buildHexMesh(lp.input);
@@ -151,6 +176,26 @@ void Simulation::decompose(const SceneConfig& scene) {
   domain_.cells = lp.cells;
   domain_.nodes = lp.nodes;
   Kokkos::fence();
+}
+
+void Simulation::gatherPoints() {
+  if (ranks_ <= 1 || !hasMesh_) return;
+  const lid_t n = localMesh_.nOwnedNodes();
+  auto gid = Kokkos::create_mirror_view_and_copy(HostSpace(), localMesh_.nodeGlobalIds());
+  auto x = Kokkos::create_mirror_view_and_copy(HostSpace(), localMesh_.points());
+  std::vector<gid_t> ids(static_cast<std::size_t>(n));
+  std::vector<double> values(3 * static_cast<std::size_t>(n));
+  for (lid_t i = 0; i < n; ++i) {
+    ids[i] = gid(i);
+    for (int c = 0; c < 3; ++c) values[3 * static_cast<std::size_t>(i) + c] = x(i, c);
+  }
+  const std::vector<double> all =
+      gatherByGlobalId(MPI_COMM_WORLD, 0, ids, values, 3, static_cast<std::size_t>(mesh_.nNodes()));
+  if (rank_ != 0) return;
+  auto h = Kokkos::create_mirror_view(mesh_.points());
+  for (lid_t i = 0; i < mesh_.nNodes(); ++i)
+    for (int c = 0; c < 3; ++c) h(i, c) = all[3 * static_cast<std::size_t>(i) + c];
+  Kokkos::deep_copy(mesh_.points(), h);
 }
 
 void Simulation::meshMetrics(std::map<std::string, double>& m) const {
@@ -173,6 +218,7 @@ io::FieldFrame Simulation::fieldFrame(double time, long long step) {
   io::FieldFrame frame;
   frame.time = time;
   frame.step = step;
+  gatherPoints();  // the moved mesh, for rank 0 to write
   if (hasMesh_ && rank_ == 0) {
     io::OutputGrid g;
     g.name = "mesh";
@@ -297,6 +343,7 @@ RunResult Simulation::run(const std::string& outDir, bool terminal, bool continu
   r.simTime = ts.time;
   {
     ScopedTimer t(timers_, "metrics");
+    gatherPoints();
     meshMetrics(r.metrics);
     if (r.steadyStateReached) r.metrics["time.steady_state_reached"] = 1.0;
     r.metrics["output.field_frames"] = fields.frames();

@@ -49,6 +49,11 @@ struct RunResult {
   std::string steadyStateMissed;
 };
 
+/// \brief The cells along every membrane a scene cuts from its mesh (the owners of its baffle's
+/// faces, both sides, or of its wall patch's faces), one group per membrane: what a decomposition
+/// keeps on one rank (the seed's singleProcessorFaceSets).
+std::vector<std::vector<lid_t>> membraneCellGroups(const SceneConfig& scene, const HexMesh& mesh);
+
 class Simulation {
  public:
   /// Build the mesh and the modules the scene names. Throws InputError on bad input.
@@ -94,9 +99,11 @@ class Simulation {
   /// from the reference mesh, each cell's scaled Jacobian) and every module's fields.
   io::FieldFrame fieldFrame(double time, long long step);
 
-  /// Build this rank's part of mesh_ (METIS over the ranks); throws InputError for what does not
-  /// run on several ranks yet.
+  /// Build this rank's part of mesh_ (METIS over the ranks, each membrane's cells on one rank);
+  /// throws InputError for what does not run on several ranks yet.
   void decompose(const SceneConfig& scene);
+  /// Several ranks: the points of mesh_ on rank 0 <- the parts' moved points (collective).
+  void gatherPoints();
 
   Timers timers_;
   bool hasMesh_ = false;

@@ -10,7 +10,7 @@ void jacobiSweep(const ExecSpace& exec, const SmoothingGraph& g, const ConstReal
   const ConstReal3View sn = g.slideNormal;
   const bool sliding = sn.extent(0) > 0;
   Kokkos::parallel_for(
-      "mfsi::kernels::smoothing::jacobiSweep", RangePolicy(exec, 0, g.nNodes()), KOKKOS_LAMBDA(lid_t i) {
+      "mfsi::kernels::smoothing::jacobiSweep", RangePolicy(exec, 0, g.nRows()), KOKKOS_LAMBDA(lid_t i) {
         const lid_t k0 = off(i), k1 = off(i + 1);
         if (fixed(i) != 0 || k1 == k0) {
           for (int c = 0; c < 3; ++c) out(i, c) = in(i, c);
@@ -33,6 +33,7 @@ void jacobiSweep(const ExecSpace& exec, const SmoothingGraph& g, const ConstReal
         }
         for (int c = 0; c < 3; ++c) out(i, c) = in(i, c) + m[c];
       });
+  g.comm.updateGhosts(exec, out);
 }
 
 void jacobiSmooth(const ExecSpace& exec, const SmoothingGraph& g, const Real3View& d, const Real3View& work,

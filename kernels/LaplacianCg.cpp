@@ -47,21 +47,23 @@ void allocate(LaplacianCgWork& w, lid_t n) {
 
 /// The scalar graph Laplacian of one displacement component on the nodes free in it, as a CSR
 /// matrix (row k for node freeNodes[k]): the diagonal sum_j w_ij over every neighbour, -w_ij for
-/// free neighbours (a held neighbour's value is Dirichlet data, which the residual carries).
+/// free neighbours (a held neighbour's value is Dirichlet data, which the residual carries). On a
+/// decomposed mesh the rows are the owned free nodes and a ghost neighbour is left out like a held
+/// one: the preconditioner is then block Jacobi over the ranks, an AMG per rank.
 /// `held(i)`: the node is fixed, or slides in a plane whose normal lies mostly along this
 /// component (exactly what it holds for axis-aligned planes; for a slanted plane the preconditioner
 /// is approximate and the CG projection keeps the iterate exact). Symmetric positive definite
 /// when every connected part of the graph has a held node. Host, once per graph.
 template <class Held>
 CsrMatrix componentLaplacian(const SmoothingGraph& g, const Held& held, std::vector<lid_t>& freeNodes) {
-  const lid_t n = g.nNodes();
+  const lid_t n = g.nNodes(), owned = g.nRows();
   auto off = Kokkos::create_mirror_view_and_copy(HostSpace(), g.offsets);
   auto nb = Kokkos::create_mirror_view_and_copy(HostSpace(), g.neighbours);
   const bool weighted = g.weights.extent(0) > 0;
   auto w = Kokkos::create_mirror_view_and_copy(HostSpace(), g.weights);
   std::vector<lid_t> row(n, -1);
   freeNodes.clear();
-  for (lid_t i = 0; i < n; ++i)
+  for (lid_t i = 0; i < owned; ++i)
     if (!held(i)) {
       row[i] = static_cast<lid_t>(freeNodes.size());
       freeNodes.push_back(i);
@@ -130,7 +132,7 @@ void allocateAmg(const ExecSpace& exec, const SmoothingGraph& g, LaplacianCgWork
 /// on the free space (zero at fixed nodes: held in every component, never written; the plane at
 /// sliding nodes); returns r . z.
 double amgPrecondition(const ExecSpace& exec, const SmoothingGraph& g, LaplacianCgWork& w) {
-  const lid_t n = g.nNodes();
+  const lid_t n = g.nRows();
   const Real3View r = w.r, z = w.z;
   const RealView rc = w.rc, zc = w.zc;
   Kokkos::deep_copy(exec, z, 0.0);
@@ -148,8 +150,7 @@ double amgPrecondition(const ExecSpace& exec, const SmoothingGraph& g, Laplacian
   }
   const ConstReal3View sn = g.slideNormal;
   const bool sliding = sn.extent(0) > 0;
-  const SolverComm comm;
-  return blas::reduce<1>(exec, comm, "mfsi::kernels::laplacianCg::project", n,
+  return blas::reduce<1>(exec, g.comm, "mfsi::kernels::laplacianCg::project", n,
                          KOKKOS_LAMBDA(lid_t i, blas::Sums<1> & acc) {
                            if (sliding) {
                              const real zn = z(i, 0) * sn(i, 0) + z(i, 1) * sn(i, 1) + z(i, 2) * sn(i, 2);
@@ -163,15 +164,16 @@ double amgPrecondition(const ExecSpace& exec, const SmoothingGraph& g, Laplacian
 
 LaplacianCgResult laplacianCg(const ExecSpace& exec, const SmoothingGraph& g, const Real3View& d, LaplacianCgWork& work,
                               const LaplacianCgOptions& options) {
-  const lid_t n = g.nNodes();
-  allocate(work, n);
+  allocate(work, g.nNodes());
+  const lid_t n = g.nRows();
   const bool amg = options.preconditioner == LaplacianPreconditioner::Amg;
   if (amg) allocateAmg(exec, g, work);
   const LaplacianRow row = rowOf(g);
   const auto fixed = g.fixed;
   const Real3View r = work.r, p = work.p, q = work.q;
   const RealView dinv = work.inverseDiagonal;
-  const SolverComm comm;
+  const SolverComm& comm = g.comm;
+  comm.updateGhosts(exec, d);
   // r = -L d on the free nodes; z = D^-1 r; p = z.
   const auto s0 = blas::reduce<3>(exec, comm, "mfsi::kernels::laplacianCg::start", n,
                                   KOKKOS_LAMBDA(lid_t i, blas::Sums<3> & acc) {
@@ -201,7 +203,7 @@ LaplacianCgResult laplacianCg(const ExecSpace& exec, const SmoothingGraph& g, co
   const double target = std::max({options.absTol, options.relTol * scale, floor});
   if (!(res.initialResidual > target)) {
     res.converged = true;
-    return res;
+    return res;  // d untouched (its ghosts refreshed)
   }
   const Real3View z = work.z;
   if (amg) {
@@ -209,6 +211,7 @@ LaplacianCgResult laplacianCg(const ExecSpace& exec, const SmoothingGraph& g, co
     Kokkos::deep_copy(exec, p, z);
   }
   for (int it = 0; it < options.maxIterations; ++it) {
+    comm.updateGhosts(exec, p);
     const auto pq = blas::reduce<1>(exec, comm, "mfsi::kernels::laplacianCg::apply", n,
                                     KOKKOS_LAMBDA(lid_t i, blas::Sums<1> & acc) {
                                       real v[3] = {0, 0, 0};
@@ -245,6 +248,7 @@ LaplacianCgResult laplacianCg(const ExecSpace& exec, const SmoothingGraph& g, co
           for (int c = 0; c < 3; ++c) p(i, c) = (amg ? z(i, c) : r(i, c) * dinv(i)) + beta * p(i, c);
         });
   }
+  comm.updateGhosts(exec, d);
   return res;
 }
 

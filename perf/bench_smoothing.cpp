@@ -21,7 +21,10 @@ void BM_JacobiSweep(benchmark::State& state) {
   auto mesh = mfsi::buildHexMesh(mfsi::generateBlockMesh(mfsi::boxSpec({0, 0, 0}, {1, 1, 1}, {n, n, n})));
   const mfsi::lid_t nn = mesh.nNodes();
   Kokkos::View<std::uint8_t*, mfsi::MemSpace> fixed("mfsi::perf::smoothing::fixed", nn);
-  const mfsi::SmoothingGraph g{mesh.nodeNodeOffsets(), mesh.nodeNodes(), fixed, {}, {}};
+  mfsi::SmoothingGraph g;
+  g.offsets = mesh.nodeNodeOffsets();
+  g.neighbours = mesh.nodeNodes();
+  g.fixed = fixed;
   mfsi::Real3View a("mfsi::perf::smoothing::a", nn), b("mfsi::perf::smoothing::b", nn);
   Kokkos::deep_copy(a, 1.0);
   mfsi::ExecSpace exec;

@@ -137,6 +137,7 @@ void interfaceDisplacement(const ExecSpace& exec, const MembraneInterface& iface
   const ConstIndexView node = iface.fluidNode;
   Kokkos::parallel_for(
       "mfsi::coupling::interface::displacement", RangePolicy(exec, 0, iface.nNodes()), KOKKOS_LAMBDA(lid_t i) {
+        if (node(i) < 0) return;  // not on this rank's part of the mesh
         for (int k = 0; k < 3; ++k) meshDisplacement(node(i), k) = u(3 * i + k);
       });
 }

@@ -30,7 +30,7 @@ enum class InterfaceSide { Baffle, Patch };
 struct MembraneInterface {
   std::string surface;  ///< the baffle name (both sides) or the patch name: what the fluid calls it
   InterfaceSide side = InterfaceSide::Patch;
-  IndexView fluidNode;  ///< membrane node -> fluid node
+  IndexView fluidNode;  ///< membrane node -> fluid node (-1: not on this rank's part of the mesh)
   IndexView front;      ///< membrane element -> boundary face index (f - nInternalFaces) of the master / patch face
   IndexView back;       ///< baffle: element -> boundary face index of the slave face; patch: size 0
   lid_t nNodes() const { return static_cast<lid_t>(fluidNode.extent(0)); }
@@ -77,7 +77,8 @@ ElementGraph elementGraph(const std::vector<std::array<lid_t, 4>>& elements, con
 void smoothInterfacePressure(const ExecSpace& exec, const ElementGraph& g, const RealView& p, const RealView& work,
                              int iterations);
 
-/// \brief meshDisplacement(fluidNode(i)) = u(3 i .. 3 i + 2) for every membrane node.
+/// \brief meshDisplacement(fluidNode(i)) = u(3 i .. 3 i + 2) for every membrane node (a node
+/// with fluidNode -1, not on this rank's part of the mesh, is skipped).
 void interfaceDisplacement(const ExecSpace& exec, const MembraneInterface& iface, const ConstRealView& u,
                            const Real3View& meshDisplacement);
 

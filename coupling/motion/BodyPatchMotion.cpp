@@ -6,25 +6,35 @@
 
 namespace mfsi::coupling {
 
-BodyPatchMotion::BodyPatchMotion(const HexMesh& mesh, const std::vector<std::string>& patches) {
-  auto fn = Kokkos::create_mirror_view_and_copy(HostSpace(), mesh.faceNodes());
+BodyPatchMotion::BodyPatchMotion(const HexMesh& mesh, const std::vector<std::string>& patches)
+    : BodyPatchMotion(mesh, patches, mesh) {}
+
+BodyPatchMotion::BodyPatchMotion(const HexMesh& whole, const std::vector<std::string>& patches, const HexMesh& part) {
+  auto fn = Kokkos::create_mirror_view_and_copy(HostSpace(), whole.faceNodes());
+  std::vector<lid_t> wholeNodes;
   for (const auto& name : patches) {
-    const std::vector<int> indices = patchIndices(mesh, name);
+    const std::vector<int> indices = patchIndices(whole, name);
     MFSI_CHECK(!indices.empty(), "body patch motion: no patch or baffle '" << name << "'");
     for (int pi : indices) {
-      const auto& patch = mesh.patches()[pi];
+      const auto& patch = whole.patches()[pi];
       for (lid_t f = patch.start; f < patch.start + patch.size; ++f)
-        for (int a = 0; a < 4; ++a) hostNodes_.push_back(fn(f, a));
+        for (int a = 0; a < 4; ++a) wholeNodes.push_back(fn(f, a));
     }
   }
-  std::sort(hostNodes_.begin(), hostNodes_.end());
-  hostNodes_.erase(std::unique(hostNodes_.begin(), hostNodes_.end()), hostNodes_.end());
+  std::sort(wholeNodes.begin(), wholeNodes.end());
+  wholeNodes.erase(std::unique(wholeNodes.begin(), wholeNodes.end()), wholeNodes.end());
+  // The part's index of each of those nodes it holds (on one whole mesh: the same index).
+  std::vector<lid_t> local(static_cast<std::size_t>(whole.nNodes()), -1);
+  auto gid = Kokkos::create_mirror_view_and_copy(HostSpace(), part.nodeGlobalIds());
+  for (lid_t i = 0; i < part.nNodes(); ++i) local[static_cast<std::size_t>(gid(i))] = i;
+  for (lid_t v : wholeNodes)
+    if (local[v] >= 0) hostNodes_.push_back(local[v]);
   const lid_t n = static_cast<lid_t>(hostNodes_.size());
   nodes_ = IndexView("mfsi::coupling::bodyPatch::nodes", n);
   reference_ = Real3View("mfsi::coupling::bodyPatch::reference", n);
   auto hn = Kokkos::create_mirror_view(nodes_);
   auto hr = Kokkos::create_mirror_view(reference_);
-  auto pts = Kokkos::create_mirror_view_and_copy(HostSpace(), mesh.points());
+  auto pts = Kokkos::create_mirror_view_and_copy(HostSpace(), part.points());
   for (lid_t i = 0; i < n; ++i) {
     hn(i) = hostNodes_[i];
     for (int k = 0; k < 3; ++k) hr(i, k) = pts(hostNodes_[i], k);

@@ -23,13 +23,17 @@ class BodyPatchMotion {
   /// The nodes of every face of `patches` (each must exist; the caller names the key), with their
   /// reference positions (the mesh's points now).
   BodyPatchMotion(const HexMesh& mesh, const std::vector<std::string>& patches);
+  /// \brief The same on one rank's part of a decomposed mesh: the nodes of the patches' faces in
+  /// the `whole` mesh that the rank holds (owned or ghost, found by global id), whether or not the
+  /// rank holds a face of the patch at that node; indices are the part's.
+  BodyPatchMotion(const HexMesh& whole, const std::vector<std::string>& patches, const HexMesh& part);
 
   /// Mesh patches a name stands for: the patch, or both sides of a baffle (<name>_master,
   /// <name>_slave); empty when the mesh has neither.
   static std::vector<int> patchIndices(const HexMesh& mesh, const std::string& name);
 
   lid_t nNodes() const { return static_cast<lid_t>(nodes_.extent(0)); }
-  /// Node indices (host copy, sorted).
+  /// Node indices (host copy, sorted by global id).
   const std::vector<lid_t>& hostNodes() const { return hostNodes_; }
 
   /// displacement(node) = T.apply(X) - X for this body's nodes; other entries untouched.

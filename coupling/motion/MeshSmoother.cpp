@@ -100,15 +100,69 @@ RealView inverseSquareEdgeWeights(const HexMesh& mesh) {
   return w;
 }
 
+/// The whole mesh's per-node flags and slide normals picked for one rank's nodes by global id.
+void localFlags(const HexMesh& part, const Kokkos::View<std::uint8_t*, MemSpace>& wholeFixed,
+                const Real3View& wholeSlide, Kokkos::View<std::uint8_t*, MemSpace>& fixed, Real3View& slide) {
+  const lid_t nn = part.nNodes();
+  auto gid = Kokkos::create_mirror_view_and_copy(HostSpace(), part.nodeGlobalIds());
+  auto wf = Kokkos::create_mirror_view_and_copy(HostSpace(), wholeFixed);
+  fixed = Kokkos::View<std::uint8_t*, MemSpace>("mfsi::coupling::motion::prescribed", nn);
+  auto hf = Kokkos::create_mirror_view(fixed);
+  for (lid_t i = 0; i < nn; ++i) hf(i) = wf(gid(i));
+  Kokkos::deep_copy(fixed, hf);
+  slide = Real3View();
+  if (wholeSlide.extent(0) == 0) return;
+  auto ws = Kokkos::create_mirror_view_and_copy(HostSpace(), wholeSlide);
+  slide = Real3View("mfsi::coupling::motion::slideNormal", nn);
+  auto hs = Kokkos::create_mirror_view(slide);
+  for (lid_t i = 0; i < nn; ++i)
+    for (int c = 0; c < 3; ++c) hs(i, c) = ws(gid(i), c);
+  Kokkos::deep_copy(slide, hs);
+}
+
+/// Throws unless every owned node of `part` has as many edges as in the whole mesh.
+void checkOwnedRows(const HexMesh& part, const HexMesh& whole) {
+  auto gid = Kokkos::create_mirror_view_and_copy(HostSpace(), part.nodeGlobalIds());
+  auto po = Kokkos::create_mirror_view_and_copy(HostSpace(), part.nodeNodeOffsets());
+  auto wo = Kokkos::create_mirror_view_and_copy(HostSpace(), whole.nodeNodeOffsets());
+  for (lid_t i = 0; i < part.nOwnedNodes(); ++i) {
+    const lid_t g = static_cast<lid_t>(gid(i));
+    if (po(i + 1) - po(i) != wo(g + 1) - wo(g))
+      throw InputError("mesh motion on several ranks: node " + std::to_string(g) + " has " +
+                       std::to_string(wo(g + 1) - wo(g)) + " edges in the mesh but " + std::to_string(po(i + 1) - po(i)) +
+                       " on its rank (cells that meet the rank's cells at a node alone); run the scene on one rank");
+  }
+}
+
 }  // namespace
 
 MeshSmoother::MeshSmoother(const HexMesh& mesh, const MeshSmootherOptions& options)
+    : MeshSmoother(mesh, options, RankDomain{}, mesh) {}
+
+MeshSmoother::MeshSmoother(const HexMesh& mesh, const MeshSmootherOptions& options, const RankDomain& domain,
+                           const HexMesh& whole)
     : mesh_(mesh), options_(options) {
   MFSI_CHECK(options_.sweeps >= 0, "mesh motion: sweeps must be >= 0, got " << options_.sweeps);
   MFSI_CHECK(options_.retries >= 0, "mesh motion: retries must be >= 0, got " << options_.retries);
   const lid_t nn = mesh.nNodes();
-  fixed_ = boundaryNodes(mesh, options_.slidingPatches, slide_);
-  graph_ = SmoothingGraph{mesh.nodeNodeOffsets(), mesh.nodeNodes(), fixed_, {}, slide_};
+  if (domain.distributed()) {
+    checkOwnedRows(mesh, whole);
+    Real3View wholeSlide;
+    const auto wholeFixed = boundaryNodes(whole, options_.slidingPatches, wholeSlide);
+    localFlags(mesh, wholeFixed, wholeSlide, fixed_, slide_);
+    nodeHalo_ = std::make_unique<Halo>(domain.comm, domain.nodes);
+    comm_ = SolverComm(domain.comm, nodeHalo_.get());
+  } else {
+    fixed_ = boundaryNodes(mesh, options_.slidingPatches, slide_);
+  }
+  graph_.offsets = mesh.nodeNodeOffsets();
+  graph_.neighbours = mesh.nodeNodes();
+  graph_.fixed = fixed_;
+  graph_.slideNormal = slide_;
+  if (domain.distributed()) {
+    graph_.owned = mesh.nOwnedNodes();
+    graph_.comm = comm_;
+  }
   stiff_ = graph_;
   stiff_.weights = inverseSquareEdgeWeights(mesh);
   d_ = Real3View("mfsi::coupling::motion::displacement", nn);
@@ -133,7 +187,7 @@ MotionReport MeshSmoother::move(const ExecSpace& exec) {
   MotionReport rep;
   auto measure = [&](int sweeps, int attempt, bool stiff) {
     place(exec, d_);
-    rep = MotionReport{sweeps, attempt, stiff, minScaledJacobian(exec, mesh_)};
+    rep = MotionReport{sweeps, attempt, stiff, -comm_.globalMax(-minScaledJacobian(exec, mesh_))};
   };
   if (options_.method == MeshMotionMethod::ConjugateGradient) {
     // Solved once, on the 1/L^2-weighted graph: on a graded mesh the plain graph Laplacian is

@@ -14,7 +14,10 @@
 #include "kernels/JacobiSmoothing.hpp"
 #include "kernels/LaplacianCg.hpp"
 
+#include "core/parallel/Halo.hpp"
+
 #include <cstdint>
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -60,6 +63,15 @@ class MeshSmoother {
   /// empty patches (2D front and back) and sliding patches (nodes slide in the patch plane); the
   /// others are smoothed. Throws InputError for an unknown sliding patch. The mesh must outlive the smoother; `move` moves its points.
   MeshSmoother(const HexMesh& mesh, const MeshSmootherOptions& options);
+  /// \brief The same on one rank's part of a decomposed mesh (`domain` distributed): `whole` is
+  /// the whole mesh (every rank holds it at start-up), from which the prescribed and sliding nodes
+  /// are found, so that a node on the mesh's boundary is prescribed on every rank that holds it,
+  /// whichever of its faces the rank has. The owned nodes are smoothed, the ghosts follow their
+  /// owners through the node halo, and the quality guard takes the minimum over all ranks. Throws
+  /// InputError when an owned node's edges are not all on its rank (a mesh whose cells meet a
+  /// rank's cells at a node alone: the one ghost layer does not complete its row).
+  MeshSmoother(const HexMesh& mesh, const MeshSmootherOptions& options, const RankDomain& domain,
+               const HexMesh& whole);
 
   /// Displacement of every node from the reference mesh [m]: set the prescribed (boundary) entries
   /// before `move`; interior entries hold the last smoothed values.
@@ -89,6 +101,8 @@ class MeshSmoother {
   Real3View d_, work_, start_, good_;
   Real3View slide_;  ///< unit normal of sliding nodes (zero elsewhere); empty without sliding patches
   LaplacianCgWork cg_;
+  std::unique_ptr<Halo> nodeHalo_;  ///< decomposed mesh: the ghosts of the displacement
+  SolverComm comm_;
 };
 
 }  // namespace mfsi::coupling

@@ -65,6 +65,7 @@ void ParentFrames::displacement(const ExecSpace& exec, const ConstReal3View& ref
   Kokkos::parallel_for(
       "mfsi::coupling::parentFrames::displacement", RangePolicy(exec, 0, static_cast<lid_t>(weights_.extent(0))),
       KOKKOS_LAMBDA(lid_t i) {
+        if (fluidNode(i) < 0) return;  // not on this rank's part of the mesh
         real x[3] = {0, 0, 0};
         for (int b = 0; b < nb; ++b) {
           const real w = W(i, b);

@@ -41,6 +41,7 @@ class ParentFrames {
 
   /// displacement(fluidNode(i)) = sum_b w_ib (c_b + Q_b (X_i + u_i - c0_b)) - X_i for the
   /// membrane's nodes, with u the relative displacement (3 per node) and X the reference positions.
+  /// A node with fluidNode -1 (not on this rank's part of the mesh) is skipped.
   void displacement(const ExecSpace& exec, const ConstReal3View& reference, const ConstRealView& relative,
                     const ConstIndexView& fluidNode, const Real3View& meshDisplacement) const;
 

@@ -36,10 +36,12 @@ void toDevice(const InterfaceVector& x, Eigen::Index offset, const RealView& d) 
 
 FsiCoupling::FsiCoupling(const CouplingOptions& options, const SceneConfig& section, HexMesh& mesh, Timers& timers,
                          std::unique_ptr<FluidModule> fluid, std::vector<std::unique_ptr<MembraneModule>> membranes,
-                         std::unique_ptr<RigidModule> rigid)
+                         std::unique_ptr<RigidModule> rigid, const HexMesh* whole, const RankDomain* domain)
     : Module("coupling"),
       options_(options),
       mesh_(mesh),
+      whole_(whole != nullptr ? *whole : mesh),
+      comm_(domain != nullptr && domain->distributed() ? domain->comm : MPI_COMM_NULL),
       timers_(timers),
       fluid_(std::move(fluid)),
       ownedMembranes_(std::move(membranes)),
@@ -66,8 +68,9 @@ FsiCoupling::FsiCoupling(const CouplingOptions& options, const SceneConfig& sect
                "coupling: " << m->name() << "'s mesh does not match its fluid surface");
     const bool baffle = po.mesh.kind == MembraneMeshKind::Baffle;
     const std::string surface = baffle ? po.mesh.baffle : po.mesh.patch;
-    p.iface = coupling::makeMembraneInterface(mesh_, surf, surface,
-                                              baffle ? coupling::InterfaceSide::Baffle : coupling::InterfaceSide::Patch);
+    p.surface = coupling::SurfaceGather(whole_, mesh_, comm_, surf, surface,
+                                        baffle ? coupling::InterfaceSide::Baffle : coupling::InterfaceSide::Patch);
+    p.iface = p.surface.gatheredInterface();
     p.dynamic = po.analysis == MembraneAnalysis::Dynamic;
     // The fluid walls on the membrane must move with it: either they take the membrane velocity
     // (membraneWall: External), or the mesh velocity (movingWall).
@@ -92,14 +95,9 @@ FsiCoupling::FsiCoupling(const CouplingOptions& options, const SceneConfig& sect
     }
     if (options_.pNetFilterTau > 0) p.filtered = RealView("mfsi::coupling::filteredLoad", mm.nElements());
     m->solver().loads().elementPressure = p.load;
-    p.frontPatch = baffle ? surface + "_master" : surface;
-    p.backPatch = baffle ? surface + "_slave" : "";
     if (options_.viscousTraction) {
       p.force = Real3View("mfsi::coupling::viscousForce", mm.nNodes());
       p.forcePrevious = Real3View("mfsi::coupling::viscousForcePrevious", mm.nNodes());
-      p.tractionFront = Real3View("mfsi::coupling::tractionFront", mm.nElements());
-      p.tractionBack = Real3View("mfsi::coupling::tractionBack", baffle ? mm.nElements() : 0);
-      p.pressureTraction = Real3View("mfsi::coupling::pressureTraction", mm.nElements());
       m->solver().loads().nodeForce = p.force;
     }
     p.offset = size_;
@@ -114,7 +112,9 @@ FsiCoupling::FsiCoupling(const CouplingOptions& options, const SceneConfig& sect
   }
   setUpBodies(section, layout);
   setUpParents(section);
-  smoother_ = std::make_unique<coupling::MeshSmoother>(mesh_, options_.motion);
+  smoother_ = comm_ != MPI_COMM_NULL
+                  ? std::make_unique<coupling::MeshSmoother>(mesh_, options_.motion, *domain, whole_)
+                  : std::make_unique<coupling::MeshSmoother>(mesh_, options_.motion);
   acceleration_ = coupling::makeAcceleration(options_.acceleration, layout);
 }
 
@@ -143,7 +143,7 @@ void FsiCoupling::setUpBodies(const SceneConfig& section, std::vector<coupling::
     for (std::size_t i = 0; i < bp.patches.size(); ++i) {
       const std::string& name = bp.patches[i];
       const std::string at = key + "." + std::to_string(i);
-      if (coupling::BodyPatchMotion::patchIndices(mesh_, name).empty())
+      if (coupling::BodyPatchMotion::patchIndices(whole_, name).empty())
         throw InputError(section.where(at), mesh_.noPatchMessage(name) + " (or a baffle of that name)");
       for (int pi : bc.find(name)) {
         const fluid::ResolvedPatch& rp = bc.patches()[pi];
@@ -152,7 +152,7 @@ void FsiCoupling::setUpBodies(const SceneConfig& section, std::vector<coupling::
                                                   ": make it 'type: movingWall' (wall velocity from the mesh motion)");
       }
     }
-    b.motion = coupling::BodyPatchMotion(mesh_, bp.patches);
+    b.motion = coupling::BodyPatchMotion(whole_, bp.patches, mesh_);
     b.com0 = kin.bodies[b.index].com;
     b.rotation0 = kin.bodies[b.index].frame.rotation;
     bodies_.push_back(std::move(b));
@@ -166,7 +166,7 @@ void FsiCoupling::setUpBodies(const SceneConfig& section, std::vector<coupling::
 
 void FsiCoupling::setUpParents(const SceneConfig& section) {
   if (options_.parentBodyPatches.empty()) return;
-  auto pts = Kokkos::create_mirror_view_and_copy(HostSpace(), mesh_.points());  // the reference mesh
+  auto pts = Kokkos::create_mirror_view_and_copy(HostSpace(), whole_.points());  // the reference mesh
   std::vector<std::string> membraneNames;
   for (const Panel& p : panels_) {  // the scene's names: module "membrane.<name>" -> "<name>"
     const std::string& n = p.module->panel().name;
@@ -198,7 +198,7 @@ void FsiCoupling::setUpParents(const SceneConfig& section) {
       if (slot < 0)
         throw InputError(section.where(key + "." + std::to_string(i)),
                          "'" + name + "' is not a patch of a coupled body (bodyPatches)");
-      const coupling::BodyPatchMotion patch(mesh_, {name});
+      const coupling::BodyPatchMotion patch(whole_, {name});
       for (lid_t v : patch.hostNodes()) {
         candidates.push_back({pts(v, 0), pts(v, 1), pts(v, 2)});
         candidateBody.push_back(slot);
@@ -215,8 +215,9 @@ void FsiCoupling::addOutputFields(io::FieldFrame& frame) {
   for (const Panel& p : panels_) {
     io::OutputGrid* grid = p.mounted ? frame.find(p.module->name()) : nullptr;
     if (!grid) continue;
-    if (points.empty()) points = io::hostValues(mesh_.points(), static_cast<std::size_t>(mesh_.nNodes()));
-    const std::vector<double> node = io::hostValues(p.iface.fluidNode, static_cast<std::size_t>(p.iface.nNodes()));
+    // The whole mesh: on several ranks the run gathers its points before a frame.
+    if (points.empty()) points = io::hostValues(whole_.points(), static_cast<std::size_t>(whole_.nNodes()));
+    const std::vector<lid_t>& node = p.module->fluidSurface()->fluidNode;
     for (std::size_t i = 0; i < node.size(); ++i)
       for (std::size_t k = 0; k < 3; ++k) grid->points[3 * i + k] = points[3 * static_cast<std::size_t>(node[i]) + k];
   }
@@ -248,7 +249,8 @@ void FsiCoupling::updateLoads(double scale, bool relax, double dt) {
   double change2 = 0, norm2 = 0;
   for (Panel& p : panels_) {
     Kokkos::deep_copy(exec_, p.loadPrevious, p.load);
-    coupling::interfacePressure(exec_, p.iface, f.boundaryPressure(), options_.outsidePressure, scale,
+    p.surface.gather(exec_, f);
+    coupling::interfacePressure(exec_, p.iface, p.surface.pressure(), options_.outsidePressure, scale,
                                 options_.pClamp, p.load);
     if (options_.pNetSmoothIter > 0)
       coupling::smoothInterfacePressure(exec_, p.graph, p.load, p.smoothWork, options_.pNetSmoothIter);
@@ -275,10 +277,10 @@ void FsiCoupling::updateLoads(double scale, bool relax, double dt) {
     norm2 += n;
     if (!options_.viscousTraction) continue;
     Kokkos::deep_copy(exec_, p.forcePrevious, p.force);
-    fluid::boundaryTraction(f, p.frontPatch, p.pressureTraction, p.tractionFront);
-    if (!p.backPatch.empty()) fluid::boundaryTraction(f, p.backPatch, p.pressureTraction, p.tractionBack);
-    coupling::interfaceViscousForce(exec_, p.iface, p.module->solver().mesh().nodeElements(), mesh_.nInternalFaces(),
-                                    f.geometry().faceAreaMag, p.tractionFront, p.tractionBack, scale, p.force);
+    p.surface.gatherTraction(exec_, f);
+    coupling::interfaceViscousForce(exec_, p.iface, p.module->solver().mesh().nodeElements(), 0,
+                                    p.surface.faceAreaMag(), p.surface.viscousTractionFront(),
+                                    p.surface.viscousTractionBack(), scale, p.force);
     // Relaxed like the pressure; the load residual is the pressure's alone (one unit).
     const Real3View force = p.force, fprev = p.forcePrevious;
     Kokkos::parallel_for(
@@ -314,7 +316,7 @@ void FsiCoupling::updateBodyLoads(double scale) {
       if (!p.mounted) continue;
       const std::array<double, 6> L = p.parents.bodyLoad(
           exec_, static_cast<int>(slot), {c[0], c[1], c[2]}, p.module->solver().mesh().elementNodes(), p.load,
-          p.iface.front, mesh_.nInternalFaces(), f.geometry().faceArea, f.geometry().faceCentroid);
+          p.iface.front, 0, p.surface.faceArea(), p.surface.faceCentroid());
       for (int k = 0; k < 3; ++k) {
         force[k] += L[k];
         moment[k] += L[3 + k];
@@ -464,7 +466,7 @@ void FsiCoupling::moveMesh(const InterfaceVector& x) {
     if (!p.wallVelocity) continue;
     MembraneSolver& s = p.module->solver();
     coupling::interfaceFaceVelocity(exec_, p.iface, s.mesh().elementNodes(), s.trialVelocity(), p.faceVelocity);
-    fluid_->solver().setWallVelocity(p.iface.surface, p.faceVelocity);
+    p.surface.setWallVelocity(exec_, fluid_->solver(), p.faceVelocity);
   }
 }
 
@@ -655,8 +657,9 @@ ModuleEntry couplingModuleEntry() {
             }
             *ctx.built = std::move(rest);
             if (!fluid) throw InputError(section.where(), "the coupling needs the scene's 'fluid' section");
-            out.push_back(std::make_unique<FsiCoupling>(options, section, *ctx.mesh, *ctx.timers,
-                                                        std::move(fluid), std::move(membranes), std::move(rigid)));
+            out.push_back(std::make_unique<FsiCoupling>(options, section, *ctx.mesh, *ctx.timers, std::move(fluid),
+                                                        std::move(membranes), std::move(rigid), ctx.wholeMesh,
+                                                        ctx.domain));
             return out;
           }};
 }

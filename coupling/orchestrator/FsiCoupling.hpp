@@ -33,6 +33,7 @@
 #include "coupling/motion/BodyPatchMotion.hpp"
 #include "coupling/motion/ParentFrames.hpp"
 #include "coupling/interface/MembraneInterface.hpp"
+#include "coupling/interface/SurfaceGather.hpp"
 #include "coupling/motion/MeshSmoother.hpp"
 #include "coupling/orchestrator/CouplingConfig.hpp"
 
@@ -48,9 +49,16 @@ class FsiCoupling final : public Module {
   /// mesh (the scene's) must outlive the module; the fluid keeps its geometry. Throws InputError
   /// naming the section for membranes that are not on the fluid mesh, unknown bodies or patches, or
   /// fluid walls that cannot follow them.
+  ///
+  /// On several ranks `mesh` is this rank's part, `domain` names the others and `whole` is the
+  /// whole mesh, from which every rank cut the same membranes: each rank solves every membrane
+  /// and body on the same gathered loads (coupling/interface/SurfaceGather), so the interface
+  /// vectors, residuals and accelerations are the same on every rank without further messages;
+  /// the mesh motion and the fluid run on the parts.
   FsiCoupling(const CouplingOptions& options, const SceneConfig& section, HexMesh& mesh, Timers& timers,
               std::unique_ptr<FluidModule> fluid, std::vector<std::unique_ptr<MembraneModule>> membranes,
-              std::unique_ptr<RigidModule> rigid = nullptr);
+              std::unique_ptr<RigidModule> rigid = nullptr, const HexMesh* whole = nullptr,
+              const RankDomain* domain = nullptr);
 
   void advance(const TimeState& t) override;
 
@@ -91,13 +99,12 @@ class FsiCoupling final : public Module {
   // member functions. They expect the state advance() sets up around them: not API.
   struct Panel {
     MembraneModule* module = nullptr;
-    coupling::MembraneInterface iface;
+    coupling::SurfaceGather surface;  ///< the fluid's values on the membrane's faces, gathered
+    coupling::MembraneInterface iface;  ///< on the gathered slots (surface.gatheredInterface())
     bool dynamic = false;
     bool wallVelocity = false;  ///< the fluid takes the membrane velocity (External walls)
     RealView load, loadPrevious;  ///< element pressure in use, and of the previous iteration
     Real3View force, forcePrevious;  ///< viscous nodal forces in use, and of the previous iteration
-    Real3View tractionFront, tractionBack, pressureTraction;  ///< per face, work of boundaryTraction
-    std::string frontPatch, backPatch;  ///< fluid patch names of the faces (back: baffle only)
     Real3View faceVelocity;
     RealView iterate;  ///< this panel's slice of an interface iterate on the device (3 per node)
     Eigen::Index offset = 0;
@@ -147,6 +154,8 @@ class FsiCoupling final : public Module {
 
   CouplingOptions options_;
   HexMesh& mesh_;
+  const HexMesh& whole_;  ///< the whole mesh (mesh_ itself on one rank)
+  MPI_Comm comm_ = MPI_COMM_NULL;  ///< several ranks: the ranks
   Timers& timers_;
   ExecSpace exec_;
   std::unique_ptr<FluidModule> fluid_;

@@ -40,7 +40,9 @@ Graph boxGraph(int n, std::array<double, 3> grading = {1, 1, 1}) {
     hf(i) = b ? 1 : 0;
   }
   Kokkos::deep_copy(r.fixed, hf);
-  r.g = mfsi::SmoothingGraph{r.mesh.nodeNodeOffsets(), r.mesh.nodeNodes(), r.fixed, {}, {}};
+  r.g.offsets = r.mesh.nodeNodeOffsets();
+  r.g.neighbours = r.mesh.nodeNodes();
+  r.g.fixed = r.fixed;
   return r;
 }
 
