@@ -11,14 +11,6 @@
 #include "support/DistributedFluidCases.hpp"
 #include "support/LocalParts.hpp"
 
-namespace mfsi::test {
-inline std::vector<int> metisParts(const HexMeshInput& in, int parts) {
-  PartitionOptions opt;
-  opt.parts = parts;
-  return partitionCells(in, opt).cellRank;
-}
-}  // namespace mfsi::test
-
 TEST(DistributedFluid, CavityOnMetisParts) {
   const mfsi::HexMeshInput in = mfsi::test::cavityCube(8);
   mfsi::test::checkDistributedFluid(in, mfsi::test::cavityOptions(), mfsi::test::metisParts(in, kRanks), 4, 0.05);

@@ -40,6 +40,13 @@ inline PartitionOptions keepPanelTogether(const HexMeshInput& in, int ranks) {
   return opt;
 }
 
+/// METIS over `parts` ranks with the default options.
+inline std::vector<int> metisParts(const HexMeshInput& in, int parts) {
+  PartitionOptions opt;
+  opt.parts = parts;
+  return partitionCells(in, opt).cellRank;
+}
+
 /// A deliberately bad partition: every cell on a random rank (fixed seed), so nearly every face
 /// is cut and most cells are ghosts somewhere.
 inline std::vector<int> randomPartition(std::size_t nCells, int ranks, unsigned seed = 12345) {
