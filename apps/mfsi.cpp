@@ -451,17 +451,9 @@ int main(int argc, char** argv) {
     for (auto& a : kargs) kargv.push_back(a.data());
     int kargc = static_cast<int>(kargv.size());
     Kokkos::ScopeGuard kokkos(kargc, kargv.data());
-    int worldSize = 1, worldRank = 0;
-    if (mpi) {
-      MPI_Comm_size(MPI_COMM_WORLD, &worldSize);
-      MPI_Comm_rank(MPI_COMM_WORLD, &worldRank);
-    }
-    if (app.got_subcommand("run") && worldSize > 1 && !restart.empty()) {
-      if (worldRank == 0)
-        std::cerr << "error: --restart runs on one rank (started on " << worldSize
-                  << " ranks): several ranks write no checkpoints yet\n";
-      code = 2;
-    } else if (app.got_subcommand("partition")) {
+    int worldRank = 0;
+    if (mpi) MPI_Comm_rank(MPI_COMM_WORLD, &worldRank);
+    if (app.got_subcommand("partition")) {
       code = worldRank == 0 ? commandPartition(scene, sets, partitionRanks, partitionOut) : 0;
     } else if (app.got_subcommand("run")) {
       code = commandRun(scene, sets, out, overwrite, restart);

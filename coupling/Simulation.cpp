@@ -12,6 +12,7 @@
 #include <cstdio>
 #include <cstring>
 #include <filesystem>
+#include <optional>
 
 namespace mfsi {
 
@@ -156,19 +157,20 @@ std::vector<std::vector<lid_t>> membraneCellGroups(const SceneConfig& scene, con
 }
 
 void Simulation::decompose(const SceneConfig& scene) {
-  // What runs on several ranks today: the fluid on the parts of the scene mesh, membranes cut from
-  // it and rigid bodies (each solved by every rank on the same gathered loads), the coupling and
-  // the mesh motion, the field output and reports. Checkpoints and restarts run on one rank.
+  // What runs on several ranks: the fluid on the parts of the scene mesh, membranes cut from it
+  // and rigid bodies (each solved by every rank on the same gathered loads), the coupling and the
+  // mesh motion, the field output, reports and checkpoints (one file per rank).
   const std::string how = " (run it on one rank: without mpirun, or mpirun -np 1; threads: --threads)";
   if (!hasMesh_) throw InputError(scene.where(), "a scene without a mesh runs on one rank" + how);
-  if (checkpoint_.everySteps > 0 || checkpoint_.wallSeconds > 0 || checkpoint_.final)
-    throw InputError(scene.where("output.checkpoint"), "checkpoints are not written on several ranks yet" + how);
   ScopedTimer t(timers_, "decompose");
   PartitionOptions opt;
   opt.parts = ranks_;
   opt.keepTogether = membraneCellGroups(scene, mesh_);
   const Partition part = partitionGraph(cellDualGraph(mesh_), opt);
   const LocalMeshPart lp = localMeshPart(mesh_, part.cellRank, ranks_, rank_);
+  std::uint64_t h = 1469598103934665603ull;  // FNV-1a over the map
+  for (int r : part.cellRank) h = (h ^ static_cast<std::uint64_t>(r)) * 1099511628211ull;
+  partitionHash_ = static_cast<std::int64_t>(h >> 1);
   localMesh_ = buildHexMesh(lp.input);
   localGeometry_ = allocateGeometry(localMesh_);
   computeGeometry(ExecSpace(), localMesh_, localGeometry_);
@@ -335,8 +337,7 @@ RunResult Simulation::run(const std::string& outDir, bool terminal, bool continu
     for (const auto& m : modules_)
       if (m->solvesSteadyState() && !m->steadyStateReached())
         r.steadyStateMissed += (r.steadyStateMissed.empty() ? "" : "; ") + m->steadyStateGap();
-  // (Several ranks write no checkpoint yet: an interrupted distributed run stops without one.)
-  if ((r.interruptedBy != 0 || checkpoint_.final) && lastCheckpointStep != ts.step && ranks_ == 1) checkpoint();
+  if ((r.interruptedBy != 0 || checkpoint_.final) && lastCheckpointStep != ts.step) checkpoint();
   if (fieldOutput_.final && lastFrameStep != ts.step && r.interruptedBy == 0) writeFrame();
   progress.finish();
   r.steps = ts.step;
@@ -387,39 +388,88 @@ bool restartMayChange(const std::string& difference) {
 
 }  // namespace
 
+namespace {
+/// Rank r's part of the checkpoint `main` (rank 0's file): `checkpoint_<step>.rank<r>.h5`.
+std::string rankFile(const std::string& main, int rank) {
+  const fs::path p(main);
+  return (p.parent_path() / (p.stem().string() + ".rank" + std::to_string(rank) + ".h5")).string();
+}
+}  // namespace
+
 std::string Simulation::writeCheckpoint(const std::string& outDir, const TimeState& ts, const io::FieldSeries& fields,
-                                        double nextFrameTime, long long lastFrameStep, double wall) const {
+                                        double nextFrameTime, long long lastFrameStep, double wall) {
   const fs::path dir = fs::path(outDir) / "checkpoints";
-  std::error_code ec;
-  fs::create_directories(dir, ec);
-  if (ec) throw OutputError("cannot create '" + dir.string() + "': " + ec.message());
   char name[64];
   std::snprintf(name, sizeof name, "%s%09lld.h5", kCheckpointPrefix, static_cast<long long>(ts.step));
   const std::string path = (dir / name).string();
-  io::Hdf5File file = io::Hdf5File::create(path);
-  io::StateWriter run(file, "/run");
-  run.putText("version", MFSI_VERSION);
-  run.putText("scene", sceneText_);
-  run.putInt("step", ts.step);
-  run.put("time", std::vector<double>{ts.time, ts.dt, ts.dtOld, nextFrameTime, wall});
-  run.putInt("lastFrameStep", lastFrameStep);
-  run.putInt("firstStep", firstStep_);
-  run.putText("fields", fields.state());
-  if (hasMesh_) {
-    io::StateWriter mesh(file, "/mesh");
-    mesh.putView("points", mesh_.points());
+  gatherPoints();  // several ranks: the whole mesh's points on rank 0
+  // Every rank writes its file; rank 0 commits its own only when all others have committed theirs.
+  std::string failure;
+  std::optional<io::Hdf5File> file;
+  try {
+    std::error_code ec;
+    fs::create_directories(dir, ec);
+    if (ec && !fs::is_directory(dir)) throw OutputError("cannot create '" + dir.string() + "': " + ec.message());
+    file.emplace(io::Hdf5File::create(rank_ == 0 ? path : rankFile(path, rank_)));
+    io::StateWriter run(*file, "/run");
+    run.putInt("ranks", ranks_);
+    run.putInt("rank", rank_);
+    if (rank_ == 0) {
+      run.putText("version", MFSI_VERSION);
+      run.putText("scene", sceneText_);
+      run.putInt("step", ts.step);
+      run.put("time", std::vector<double>{ts.time, ts.dt, ts.dtOld, nextFrameTime, wall});
+      run.putInt("lastFrameStep", lastFrameStep);
+      run.putInt("firstStep", firstStep_);
+      run.putText("fields", fields.state());
+      run.putInt("partition", partitionHash_);
+      if (hasMesh_) {
+        io::StateWriter mesh(*file, "/mesh");
+        mesh.putView("points", mesh_.points());
+      }
+    }
+    for (const Module* m : reporting_) {
+      io::StateWriter w(*file, "/modules/" + m->name());
+      m->saveState(w);
+    }
+    if (rank_ != 0) file->commit();
+  } catch (const OutputError& e) {
+    failure = e.what();
   }
-  for (const Module* m : reporting_) {
-    io::StateWriter w(file, "/modules/" + m->name());
-    m->saveState(w);
+  if (ranks_ > 1) {
+    int ok = failure.empty() ? 1 : 0, all = 0;
+    MPI_Allreduce(&ok, &all, 1, MPI_INT, MPI_MIN, MPI_COMM_WORLD);
+    if (!all && failure.empty()) failure = "another rank could not write its part of checkpoint '" + path + "'";
   }
-  file.commit();
-  // The most recent `keep` stay.
-  const auto files = checkpointFiles(dir);
-  long long excess = static_cast<long long>(files.size()) - checkpoint_.keep;
-  for (const auto& [step, f] : files) {
-    if (excess-- <= 0) break;
-    fs::remove(f, ec);
+  if (!failure.empty()) throw OutputError(failure);  // rank 0's file, uncommitted, is removed
+  if (rank_ == 0) file->commit();
+  file.reset();
+  // The most recent `keep` stay; rank 0 names the steps to drop, every rank drops its files.
+  std::vector<long long> drop;
+  if (rank_ == 0) {
+    const auto files = checkpointFiles(dir);
+    long long excess = static_cast<long long>(files.size()) - checkpoint_.keep;
+    for (const auto& [step, f] : files) {
+      if (excess-- <= 0) break;
+      drop.push_back(step);
+    }
+  }
+  if (ranks_ > 1) {
+    long long n = static_cast<long long>(drop.size());
+    MPI_Bcast(&n, 1, MPI_LONG_LONG, 0, MPI_COMM_WORLD);
+    drop.resize(static_cast<std::size_t>(n));
+    MPI_Bcast(drop.data(), static_cast<int>(n), MPI_LONG_LONG, 0, MPI_COMM_WORLD);
+  }
+  for (long long step : drop) {
+    std::snprintf(name, sizeof name, "%s%09lld.h5", kCheckpointPrefix, step);
+    const std::string old = (dir / name).string();
+    std::error_code ec;
+    if (ranks_ > 1 && rank_ > 0) fs::remove(rankFile(old, rank_), ec);
+    if (rank_ == 0) {
+      fs::remove(old, ec);
+      // Parts of the same step from a run on more ranks than this one.
+      for (int r = 1; fs::exists(rankFile(old, r), ec); ++r) fs::remove(rankFile(old, r), ec);
+    }
   }
   return path;
 }
@@ -451,6 +501,14 @@ void Simulation::restore(const std::string& checkpointFile) {
     }
   }();
   const io::StateReader run(file, "/run");
+  const long long writtenOn = run.has("ranks") ? run.integer("ranks") : 1;
+  if (writtenOn != ranks_)
+    throw InputError("--restart: '" + checkpointFile + "' was written by a run on " + std::to_string(writtenOn) +
+                     " rank(s); continue it on as many (mpirun -np " + std::to_string(writtenOn) + "), not " +
+                     std::to_string(ranks_));
+  if (ranks_ > 1 && run.integer("partition") != partitionHash_)
+    throw InputError("--restart: '" + checkpointFile + "' holds another decomposition of the mesh than this run's "
+                     "(a different METIS?)");
   const std::string before = run.text("scene");
   std::string refused;
   for (const std::string& d : sceneDifferences(before, sceneText_))
@@ -476,12 +534,31 @@ void Simulation::restore(const std::string& checkpointFile) {
   if (hasMesh_) {
     io::StateReader mesh(file, "/mesh");
     mesh.getView("points", mesh_.points());
+    if (ranks_ > 1) {  // this rank's part: its nodes' points by global id
+      auto whole = Kokkos::create_mirror_view_and_copy(HostSpace(), mesh_.points());
+      auto gid = Kokkos::create_mirror_view_and_copy(HostSpace(), localMesh_.nodeGlobalIds());
+      auto x = Kokkos::create_mirror_view(localMesh_.points());
+      for (lid_t i = 0; i < localMesh_.nNodes(); ++i)
+        for (int c = 0; c < 3; ++c) x(i, c) = whole(gid(i), c);
+      Kokkos::deep_copy(localMesh_.points(), x);
+    }
   }
+  // Several ranks: each rank's modules from its own file.
+  std::optional<io::Hdf5File> own;
+  if (rank_ > 0) {
+    const std::string part = rankFile(checkpointFile, rank_);
+    try {
+      own.emplace(io::Hdf5File::openRead(part));
+    } catch (const OutputError& e) {
+      throw InputError(std::string("--restart: rank ") + std::to_string(rank_) + "'s part: " + e.what());
+    }
+  }
+  const io::Hdf5File& states = own ? *own : file;
   // Parts first, then the module that owns them (the coupling places its mounted membranes by
   // the bodies' state).
   for (auto& m : modules_) {
-    for (Module* p : m->parts()) p->loadState(io::StateReader(file, "/modules/" + p->name()));
-    m->loadState(io::StateReader(file, "/modules/" + m->name()));
+    for (Module* p : m->parts()) p->loadState(io::StateReader(states, "/modules/" + p->name()));
+    m->loadState(io::StateReader(states, "/modules/" + m->name()));
   }
   st.restored = true;
   completedSteps_ = st.time.step;

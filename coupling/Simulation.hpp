@@ -4,6 +4,8 @@
 #include "coupling/Module.hpp"
 #include "core/RunLog.hpp"
 
+#include <cstdint>
+
 namespace mfsi {
 
 /// Schema of a whole scene: name, description, mesh, time, and one section per catalogued module.
@@ -92,9 +94,12 @@ class Simulation {
 
  private:
   void meshMetrics(std::map<std::string, double>& m) const;
-  /// Write `<outDir>/checkpoints/checkpoint_<step>.h5` and remove the ones beyond `keep`.
+  /// Write `<outDir>/checkpoints/checkpoint_<step>.h5` and remove the ones beyond `keep`. On
+  /// several ranks rank 0 writes that file (the run, the whole mesh's points, its modules) and
+  /// rank r > 0 its modules' state to `checkpoint_<step>.rank<r>.h5`; rank 0's file is committed
+  /// last, once every rank has committed its own, so a checkpoint that a listing finds is whole.
   std::string writeCheckpoint(const std::string& outDir, const TimeState& ts, const io::FieldSeries& fields,
-                              double nextFrameTime, long long lastFrameStep, double wallSeconds) const;
+                              double nextFrameTime, long long lastFrameStep, double wallSeconds);
   /// The state now, as one output frame: the scene mesh's grid "mesh" (positions, displacement
   /// from the reference mesh, each cell's scaled Jacobian) and every module's fields.
   io::FieldFrame fieldFrame(double time, long long step);
@@ -114,6 +119,7 @@ class Simulation {
   HexMesh localMesh_;
   MeshGeometry localGeometry_;
   RankDomain domain_;
+  std::int64_t partitionHash_ = 0;  ///< several ranks: a hash of the cell -> rank map (checkpoints hold it)
   TimeOptions time_;
   long long nSteps_ = 0;  ///< from time_ (checked at set-up)
   FieldOutputOptions fieldOutput_;

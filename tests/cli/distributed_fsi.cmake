@@ -8,6 +8,9 @@
 #   1e-9 (fsiTol 1e-13; the iteration count may differ by rank count at that level).
 # - The membrane channel (two baffle membranes mounted on a sliding rigid frame): the frame's and
 #   bar's forces on 2 ranks to 1e-9, the panel's centre displacement (1e-9 m) to 1e-7.
+# - Checkpoints on 2 ranks (one file per rank, the oldest pruned on every rank): a restart on 2
+#   ranks from the middle of the cavity run gives the same steps bit for bit; a restart on 3 ranks
+#   is refused with one message (exit 2).
 find_program(MPIEXEC mpiexec)
 if(NOT MPIEXEC)
   message("MFSI_SKIP: no mpiexec")
@@ -99,3 +102,32 @@ run(channel1 1 ${channel})
 run(channel2 2 ${channel})
 same(channel1 channel2 1e-9 fluid.bar.force_x bodies.body.frame.Fx fluid.max_velocity)
 same(channel1 channel2 1e-7 membrane.panelA.centreUz membrane.panelB.centreUz)
+
+# Checkpoints every 3 steps, the last 2 kept: steps 6 and 9 on both ranks, step 3 gone from both.
+run(saved 2 ${cavity} --set output.checkpoint.everySteps=3)
+foreach(f checkpoint_000000006.h5 checkpoint_000000006.rank1.h5 checkpoint_000000009.rank1.h5)
+  if(NOT EXISTS ${WORK}/saved/checkpoints/${f})
+    message(SEND_ERROR "2 ranks: no checkpoints/${f}")
+  endif()
+endforeach()
+foreach(f checkpoint_000000003.h5 checkpoint_000000003.rank1.h5)
+  if(EXISTS ${WORK}/saved/checkpoints/${f})
+    message(SEND_ERROR "2 ranks: checkpoints/${f} was not pruned (keep: 2)")
+  endif()
+endforeach()
+run(continued 2 --restart ${WORK}/saved/checkpoints/checkpoint_000000006.h5)
+rows_without_wall(${WORK}/saved whole)
+rows_without_wall(${WORK}/continued rest)
+list(SUBLIST whole 7 -1 tail)  # header and steps 1-6 dropped
+list(REMOVE_AT rest 0)
+list(LENGTH rest nr)
+if(NOT nr EQUAL 4 OR NOT tail STREQUAL rest)
+  message(SEND_ERROR "a restart on 2 ranks from step 6 differs from the run it continues (${nr} rows):\n${rest}\n${tail}")
+endif()
+execute_process(COMMAND ${MPIEXEC} --allow-run-as-root --oversubscribe -np 3 ${MFSI} run --restart ${WORK}/saved
+  --out ${WORK}/three RESULT_VARIABLE rc OUTPUT_VARIABLE o ERROR_VARIABLE e)
+string(REGEX MATCHALL "written by a run on 2 rank" lines "${e}")
+list(LENGTH lines nl)
+if(NOT rc EQUAL 2 OR NOT nl EQUAL 1)
+  message(SEND_ERROR "a restart on 3 ranks of a 2-rank checkpoint: exit ${rc}, ${nl} messages:\n${e}")
+endif()
