@@ -439,7 +439,11 @@ std::string Simulation::writeCheckpoint(const std::string& outDir, const TimeSta
   if (ranks_ > 1) {
     int ok = failure.empty() ? 1 : 0, all = 0;
     MPI_Allreduce(&ok, &all, 1, MPI_INT, MPI_MIN, MPI_COMM_WORLD);
-    if (!all && failure.empty()) failure = "another rank could not write its part of checkpoint '" + path + "'";
+    if (!all && failure.empty()) {
+      failure = "another rank could not write its part of checkpoint '" + path + "'";
+      std::error_code ec;
+      if (rank_ > 0) fs::remove(rankFile(path, rank_), ec);  // no orphaned part
+    }
   }
   if (!failure.empty()) throw OutputError(failure);  // rank 0's file, uncommitted, is removed
   if (rank_ == 0) file->commit();
