@@ -4,6 +4,9 @@
 //   mfsi run cases/box.yaml --out /tmp/box --threads 2 [--overwrite]
 //   mfsi run --restart /tmp/box               # continue a run from its latest checkpoint
 //   mfsi run box --set mesh.blocks.0.cells=[32,16,16] --set mesh.blocks.1.cells=[48,16,16]
+//   mpirun -np 4 mfsi run flexible-cavity     # decomposed over 4 ranks (METIS at start-up)
+//   mfsi partition flexible-cavity -n 4       # the decomposition, written to results/flexible-cavity-partition4.txt
+//   mpirun -np 4 mfsi run flexible-cavity --partition results/flexible-cavity-partition4.txt
 //   mfsi check cases/box.yaml                 # validate without running (also builds the mesh)
 //   mfsi check --describe                     # every scene key with type, default, units, doc
 //   mfsi scenes                               # built-in scenes
@@ -171,7 +174,7 @@ bool sameFolder(const std::string& a, const std::string& b) {
 }
 
 int commandRun(std::string sceneArg, const std::vector<std::string>& sets, std::string out, bool overwrite,
-               const std::string& restart) {
+               const std::string& restart, const std::string& partitionMap) {
   const double t0 = mfsi::wallSeconds();
   mfsi::installInterruptHandlers();
   // --restart: the checkpoint, the folder of the run that wrote it (the default --out: the run
@@ -239,7 +242,7 @@ int commandRun(std::string sceneArg, const std::vector<std::string>& sets, std::
                 << "---- resolved scene ----\n"
                 << resolved << "------------------------\n";
     }
-    sim = std::make_unique<mfsi::Simulation>(cfg);
+    sim = std::make_unique<mfsi::Simulation>(cfg, partitionMap);
     if (sim->hasMesh()) {
       summary.cells = sim->mesh().nCells();
       summary.nodes = sim->mesh().nNodes();
@@ -352,7 +355,7 @@ int main(int argc, char** argv) {
   app.set_version_flag("--version", std::string("mfsi ") + MFSI_VERSION);
   app.require_subcommand(1);
 
-  std::string scene, out, restart;
+  std::string scene, out, restart, partitionMap;
   std::vector<std::string> sets;
   int threads = 0;
   bool describe = false;
@@ -368,6 +371,8 @@ int main(int argc, char** argv) {
                   "continue a run from a checkpoint: its folder (the latest checkpoint in it) or a checkpoint "
                   "file; the scene defaults to the run's scene.yaml and --out to its folder (continuing its files)");
   run->add_option("--threads", threads, "host threads (default: OMP_NUM_THREADS or all cores)")->check(CLI::PositiveNumber);
+  run->add_option("--partition", partitionMap,
+                  "on several ranks: the cell -> rank map `mfsi partition` wrote, instead of METIS at start-up");
 
   auto* check = app.add_subcommand("check", "validate a scene without running it");
   check->add_option("scene", scene, "scene file, or the name of a built-in scene");
@@ -456,7 +461,7 @@ int main(int argc, char** argv) {
     if (app.got_subcommand("partition")) {
       code = worldRank == 0 ? commandPartition(scene, sets, partitionRanks, partitionOut) : 0;
     } else if (app.got_subcommand("run")) {
-      code = commandRun(scene, sets, out, overwrite, restart);
+      code = commandRun(scene, sets, out, overwrite, restart, partitionMap);
     } else if (app.got_subcommand("plot")) {
       code = commandPlot(plotDir, plotOut);
     } else if (app.got_subcommand("check")) {

@@ -65,7 +65,9 @@ Schema sceneSchema() {
   return s;
 }
 
-Simulation::Simulation(const SceneConfig& scene) {
+Simulation::Simulation(const SceneConfig& scene) : Simulation(scene, std::string()) {}
+
+Simulation::Simulation(const SceneConfig& scene, const std::string& partitionFile) {
   hasMesh_ = scene.has("mesh");
   if (hasMesh_) {
     ScopedTimer t(timers_, "mesh");
@@ -106,7 +108,9 @@ Simulation::Simulation(const SceneConfig& scene) {
     MPI_Comm_size(MPI_COMM_WORLD, &ranks_);
     MPI_Comm_rank(MPI_COMM_WORLD, &rank_);
   }
-  if (ranks_ > 1) decompose(scene);
+  if (ranks_ > 1) decompose(scene, partitionFile);
+  else if (!partitionFile.empty() && hasMesh_)  // checked all the same: a map for more ranks is a mistake
+    readPartitionMap(partitionFile, static_cast<std::size_t>(mesh_.nCells()), 1);
 
   SimulationContext ctx;
   if (hasMesh_) {
@@ -156,17 +160,22 @@ std::vector<std::vector<lid_t>> membraneCellGroups(const SceneConfig& scene, con
   return groups;
 }
 
-void Simulation::decompose(const SceneConfig& scene) {
+void Simulation::decompose(const SceneConfig& scene, const std::string& partitionFile) {
   // What runs on several ranks: the fluid on the parts of the scene mesh, membranes cut from it
   // and rigid bodies (each solved by every rank on the same gathered loads), the coupling and the
   // mesh motion, the field output, reports and checkpoints (one file per rank).
   const std::string how = " (run it on one rank: without mpirun, or mpirun -np 1; threads: --threads)";
   if (!hasMesh_) throw InputError(scene.where(), "a scene without a mesh runs on one rank" + how);
   ScopedTimer t(timers_, "decompose");
-  PartitionOptions opt;
-  opt.parts = ranks_;
-  opt.keepTogether = membraneCellGroups(scene, mesh_);
-  const Partition part = partitionGraph(cellDualGraph(mesh_), opt);
+  Partition part;
+  if (partitionFile.empty()) {
+    PartitionOptions opt;
+    opt.parts = ranks_;
+    opt.keepTogether = membraneCellGroups(scene, mesh_);
+    part = partitionGraph(cellDualGraph(mesh_), opt);
+  } else {
+    part.cellRank = readPartitionMap(partitionFile, static_cast<std::size_t>(mesh_.nCells()), ranks_);
+  }
   const LocalMeshPart lp = localMeshPart(mesh_, part.cellRank, ranks_, rank_);
   std::uint64_t h = 1469598103934665603ull;  // FNV-1a over the map
   for (int r : part.cellRank) h = (h ^ static_cast<std::uint64_t>(r)) * 1099511628211ull;

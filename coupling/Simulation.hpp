@@ -60,6 +60,9 @@ class Simulation {
  public:
   /// Build the mesh and the modules the scene names. Throws InputError on bad input.
   explicit Simulation(const SceneConfig& scene);
+  /// \brief The same with the decomposition over several ranks read from `partitionFile` (as
+  /// `mfsi partition` writes it) instead of computed; empty: computed (METIS).
+  Simulation(const SceneConfig& scene, const std::string& partitionFile);
 
   /// Step to the end time, writing steps.csv into `outDir` and drawing progress. After `restore`,
   /// from the checkpoint's step on; `continueFiles`: into the folder of the run that wrote the
@@ -106,7 +109,7 @@ class Simulation {
 
   /// Build this rank's part of mesh_ (METIS over the ranks, each membrane's cells on one rank);
   /// throws InputError for what does not run on several ranks yet.
-  void decompose(const SceneConfig& scene);
+  void decompose(const SceneConfig& scene, const std::string& partitionFile);
   /// Several ranks: the points of mesh_ on rank 0 <- the parts' moved points (collective).
   void gatherPoints();
 

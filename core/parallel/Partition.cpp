@@ -5,6 +5,8 @@
 #include <metis.h>
 
 #include <algorithm>
+#include <fstream>
+#include <string>
 #include <map>
 #include <numeric>
 
@@ -174,6 +176,38 @@ CellGraph cellDualGraph(const HexMesh& mesh) {
       for (lid_t i = 0; i < p.size; ++i) join(owner(p.start + i), owner(slave.start + i));
     }
   return toGraph(adj);
+}
+
+std::vector<int> readPartitionMap(const std::string& file, std::size_t nCells, int ranks) {
+  std::ifstream in(file);
+  if (!in) throw InputError("--partition '" + file + "': cannot read the file");
+  std::vector<int> map;
+  std::vector<std::size_t> cells(static_cast<std::size_t>(ranks), 0);
+  std::string line;
+  for (long long no = 1; std::getline(in, line); ++no) {
+    const auto first = line.find_first_not_of(" \t\r");
+    if (first == std::string::npos || line[first] == '#') continue;
+    const auto last = line.find_last_not_of(" \t\r");
+    const std::string t = line.substr(first, last - first + 1);
+    long long r = -1;
+    if (t.size() <= 6 && t.find_first_not_of("0123456789") == std::string::npos) r = std::stoll(t);
+    if (r < 0 || r >= ranks)
+      throw InputError(file + ":" + std::to_string(no) + ": '" + t + "' is not a rank of this run (0 to " +
+                       std::to_string(ranks - 1) + ")");
+    if (map.size() == nCells)
+      throw InputError(file + ":" + std::to_string(no) + ": more lines than the mesh's " + std::to_string(nCells) +
+                       " cells (a map of another mesh?)");
+    map.push_back(static_cast<int>(r));
+    ++cells[static_cast<std::size_t>(r)];
+  }
+  if (map.size() != nCells)
+    throw InputError(file + ": " + std::to_string(map.size()) + " cells mapped, the mesh has " + std::to_string(nCells) +
+                     " (a map of another mesh?)");
+  for (int r = 0; r < ranks; ++r)
+    if (cells[static_cast<std::size_t>(r)] == 0)
+      throw InputError(file + ": rank " + std::to_string(r) + " gets no cell (a map for fewer ranks than the " +
+                       std::to_string(ranks) + " this run has?)");
+  return map;
 }
 
 }  // namespace mfsi

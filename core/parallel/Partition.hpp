@@ -58,6 +58,12 @@ Partition partitionGraph(const CellGraph& graph, const PartitionOptions& options
 /// `parts` < 1 or exceeds the number of movable units (cells after merging the groups).
 Partition partitionCells(const HexMeshInput& mesh, const PartitionOptions& options);
 
+/// \brief A cell -> rank map as `mfsi partition` writes it: comment lines starting with '#', then
+/// one rank per line in the mesh's cell order. Throws InputError naming the file and line for a
+/// missing file, a line that is not a rank in [0, ranks), a count other than `nCells`, or a rank
+/// left without cells.
+std::vector<int> readPartitionMap(const std::string& file, std::size_t nCells, int ranks);
+
 /// \brief Figures of a given cell -> rank map (edge cut, cells per rank, imbalance).
 Partition describePartition(const CellGraph& graph, std::vector<int> cellRank, int parts);
 

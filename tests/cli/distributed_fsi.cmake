@@ -8,6 +8,8 @@
 #   1e-9 (fsiTol 1e-13; the iteration count may differ by rank count at that level).
 # - The membrane channel (two baffle membranes mounted on a sliding rigid frame): the frame's and
 #   bar's forces on 2 ranks to 1e-9, the panel's centre displacement (1e-9 m) to 1e-7.
+# - `mfsi partition` writes the map a run computes: the cavity run on 2 ranks with --partition
+#   repeats the METIS run bit for bit; a map with a bad line is refused naming file and line.
 # - Checkpoints on 2 ranks (one file per rank, the oldest pruned on every rank): a restart on 2
 #   ranks from the middle of the cavity run gives the same steps bit for bit; a restart on 3 ranks
 #   is refused with one message (exit 2).
@@ -130,4 +132,27 @@ string(REGEX MATCHALL "written by a run on 2 rank" lines "${e}")
 list(LENGTH lines nl)
 if(NOT rc EQUAL 2 OR NOT nl EQUAL 1)
   message(SEND_ERROR "a restart on 3 ranks of a 2-rank checkpoint: exit ${rc}, ${nl} messages:\n${e}")
+endif()
+
+# The map `mfsi partition` writes is the one a run computes.
+execute_process(COMMAND ${MFSI} partition ${cavity} -n 2 --out ${WORK}/map2.txt RESULT_VARIABLE rc OUTPUT_VARIABLE o
+  ERROR_VARIABLE e)
+if(NOT rc EQUAL 0)
+  message(FATAL_ERROR "mfsi partition: exit ${rc}\n${o}\n${e}")
+endif()
+run(mapped 2 ${cavity} --partition ${WORK}/map2.txt)
+rows_without_wall(${WORK}/mapped mappedRows)
+if(NOT mappedRows STREQUAL first)
+  message(SEND_ERROR "the run on mfsi partition's map differs from the run that computed it")
+endif()
+file(STRINGS ${WORK}/map2.txt map)
+list(TRANSFORM map REPLACE "^[0-9]+$" "7" AT 4)  # line 5: a rank this run does not have
+string(REPLACE ";" "\n" map "${map}")
+file(WRITE ${WORK}/bad.txt "${map}\n")
+execute_process(COMMAND ${MPIEXEC} --allow-run-as-root --oversubscribe -np 2 ${MFSI} run ${cavity}
+  --partition ${WORK}/bad.txt --out ${WORK}/bad RESULT_VARIABLE rc OUTPUT_VARIABLE o ERROR_VARIABLE e)
+string(REGEX MATCHALL "bad.txt:5: '7' is not a rank" lines "${e}")
+list(LENGTH lines nl)
+if(NOT rc EQUAL 2 OR NOT nl EQUAL 1)
+  message(SEND_ERROR "a map with a bad line 5: exit ${rc}, ${nl} messages:\n${e}")
 endif()
