@@ -16,6 +16,7 @@
 
 #include "core/parallel/Halo.hpp"
 
+#include <array>
 #include <cstdint>
 #include <memory>
 #include <string>
@@ -44,6 +45,9 @@ struct MeshSmootherOptions {
   int maxIterations = 2000;  ///< CG: iterations per motion
   /// CG: the preconditioner (Jacobi: O(N) cheap iterations; AMG: a few V-cycles per component).
   LaplacianPreconditioner preconditioner = LaplacianPreconditioner::Amg;
+  /// CG: edge weights 1 / L^2 times 1 / d^q, d the reference distance of the edge's midpoint from
+  /// the nearest moving node (setMovingNodes); 0: off.
+  double distanceExponent = 0;
   /// Patches whose nodes slide along them (in the plane of the patch where it is flat) instead of
   /// staying put: walls next to a deflecting membrane, so the corner cells shear less.
   std::vector<std::string> slidingPatches;
@@ -78,6 +82,10 @@ class MeshSmoother {
   Real3View displacement() const { return d_; }
   /// 1 for prescribed nodes.
   Kokkos::View<const std::uint8_t*, MemSpace> prescribed() const { return fixed_; }
+
+  /// The reference positions of the nodes the coupling moves (membranes, bodies): with
+  /// options.distanceExponent > 0 the CG's edge weights grow near them. Call before the first move.
+  void setMovingNodes(const std::vector<std::array<real, 3>>& points);
 
   /// Smooth and move the mesh points; the quality guard (the minimum scaled Jacobian, from the
   /// points alone) retries as the options say. The caller recomputes whatever geometry it keeps

@@ -31,6 +31,14 @@ Schema couplingSchema() {
                    .atMost(1),
                Default(o.motion.minScaledJacobian))
           .key("retries", Schema::integer("jacobi: retries of the quality guard").atLeast(0), Default(o.motion.retries))
+          .key("distanceExponent",
+               Schema::real("cg: edge stiffness times 1 / d^q, d the reference distance from the edge to the nearest "
+                            "membrane or body node (cells near the moving surfaces move more rigidly with them, the "
+                            "far ones deform); 0: off",
+                            "-")
+                   .atLeast(0)
+                   .atMost(4),
+               Default(o.motion.distanceExponent))
           .key("slidingPatches",
                Schema::list("patches whose nodes slide along them (flat walls next to a membrane)",
                             Schema::string("patch name")),
@@ -179,6 +187,7 @@ CouplingOptions readCouplingOptions(const SceneConfig& c) {
                                                                         : coupling::MeshMotionMethod::ConjugateGradient;
   o.motion.sweeps = c.get<int>("meshMotion.sweeps");
   o.motion.relTol = c.get<double>("meshMotion.relTol");
+  o.motion.distanceExponent = c.get<double>("meshMotion.distanceExponent");
   o.motion.maxIterations = c.get<int>("meshMotion.maxIterations");
   o.motion.preconditioner = c.get<std::string>("meshMotion.preconditioner") == "amg" ? LaplacianPreconditioner::Amg
                                                                                    : LaplacianPreconditioner::Jacobi;

@@ -115,6 +115,17 @@ FsiCoupling::FsiCoupling(const CouplingOptions& options, const SceneConfig& sect
   smoother_ = comm_ != MPI_COMM_NULL
                   ? std::make_unique<coupling::MeshSmoother>(mesh_, options_.motion, *domain, whole_)
                   : std::make_unique<coupling::MeshSmoother>(mesh_, options_.motion);
+  if (options_.motion.distanceExponent > 0) {
+    std::vector<std::array<real, 3>> moving;
+    auto X = Kokkos::create_mirror_view_and_copy(HostSpace(), whole_.referencePoints());
+    for (const Panel& p : panels_)
+      for (lid_t v : p.module->fluidSurface()->fluidNode) moving.push_back({X(v, 0), X(v, 1), X(v, 2)});
+    for (const CoupledBody& b : bodies_) {
+      const coupling::BodyPatchMotion patches(whole_, b.patches);
+      for (lid_t v : patches.hostNodes()) moving.push_back({X(v, 0), X(v, 1), X(v, 2)});
+    }
+    smoother_->setMovingNodes(moving);
+  }
   acceleration_ = coupling::makeAcceleration(options_.acceleration, layout);
 }
 
