@@ -79,6 +79,66 @@ void ParentFrames::displacement(const ExecSpace& exec, const ConstReal3View& ref
       });
 }
 
+void ParentFrames::positions(const ExecSpace& exec, const ConstReal3View& reference, const ConstRealView& relative,
+                             const Real3View& x) const {
+  const auto W = weights_;
+  const auto F = frames_;
+  const int nb = nBodies_;
+  Kokkos::parallel_for(
+      "mfsi::coupling::parentFrames::positions", RangePolicy(exec, 0, static_cast<lid_t>(weights_.extent(0))),
+      KOKKOS_LAMBDA(lid_t i) {
+        real y[3] = {0, 0, 0};
+        for (int b = 0; b < nb; ++b) {
+          const real w = W(i, b);
+          if (w == 0) continue;
+          real r[3];
+          for (int k = 0; k < 3; ++k) r[k] = reference(i, k) + relative(3 * i + k) - F(b, k);
+          for (int k = 0; k < 3; ++k)
+            y[k] += w * (F(b, 3 + k) + F(b, 6 + 3 * k) * r[0] + F(b, 7 + 3 * k) * r[1] + F(b, 8 + 3 * k) * r[2]);
+        }
+        for (int k = 0; k < 3; ++k) x(i, k) = y[k];
+      });
+}
+
+void ParentFrames::toFrames(const ExecSpace& exec, const ConstReal3View& global, const Real3View& relative) const {
+  const auto W = weights_;
+  const auto F = frames_;
+  const int nb = nBodies_;
+  Kokkos::parallel_for(
+      "mfsi::coupling::parentFrames::toFrames", RangePolicy(exec, 0, static_cast<lid_t>(weights_.extent(0))),
+      KOKKOS_LAMBDA(lid_t i) {
+        real y[3] = {0, 0, 0};
+        for (int b = 0; b < nb; ++b) {
+          const real w = W(i, b);
+          if (w == 0) continue;
+          for (int k = 0; k < 3; ++k)  // (Q^T f)_k = sum_j Q_jk f_j
+            y[k] += w * (F(b, 6 + k) * global(i, 0) + F(b, 9 + k) * global(i, 1) + F(b, 12 + k) * global(i, 2));
+        }
+        for (int k = 0; k < 3; ++k) relative(i, k) = y[k];
+      });
+}
+
+std::array<double, 6> ParentFrames::nodeLoad(const ExecSpace& exec, int slot, const std::array<double, 3>& centre,
+                                             const ConstReal3View& x, const ConstReal3View& f) const {
+  const auto W = weights_;
+  const int s = slot;
+  const real cx = centre[0], cy = centre[1], cz = centre[2];
+  return blas::reduce<6>(
+      exec, SolverComm{}, "mfsi::coupling::parentFrames::nodeLoad", static_cast<lid_t>(weights_.extent(0)),
+      KOKKOS_LAMBDA(lid_t i, blas::Sums<6> & acc) {
+        const real w = W(i, s);
+        if (w == 0) return;
+        const real F[3] = {w * f(i, 0), w * f(i, 1), w * f(i, 2)};
+        const real r[3] = {x(i, 0) - cx, x(i, 1) - cy, x(i, 2) - cz};
+        acc[0] += F[0];
+        acc[1] += F[1];
+        acc[2] += F[2];
+        acc[3] += r[1] * F[2] - r[2] * F[1];
+        acc[4] += r[2] * F[0] - r[0] * F[2];
+        acc[5] += r[0] * F[1] - r[1] * F[0];
+      });
+}
+
 std::array<double, 6> ParentFrames::bodyLoad(const ExecSpace& exec, int slot, const std::array<double, 3>& centre,
                                              const ConstQuad4View& elementNodes, const ConstRealView& elementPressure,
                                              const ConstIndexView& front, lid_t nInternalFaces,

@@ -14,7 +14,8 @@
 /// blend keeps a membrane spanning two independently moving bodies continuous (nearest-body
 /// frames would tear it where the nearest body changes). The fluid's load on a mounted membrane is
 /// passed on to its parents, each element's share by its nodes' weights (the membrane's own
-/// inertia is not).
+/// inertia is not); nodal forces (the viscous traction) likewise, each node's by its weights, and
+/// they reach the frame-relative FEM rotated into the frames (sum_b w_b Q_b^T f).
 #include "core/Types.hpp"
 #include "coupling/motion/BodyPatchMotion.hpp"
 
@@ -44,6 +45,18 @@ class ParentFrames {
   /// A node with fluidNode -1 (not on this rank's part of the mesh) is skipped.
   void displacement(const ExecSpace& exec, const ConstReal3View& reference, const ConstRealView& relative,
                     const ConstIndexView& fluidNode, const Real3View& meshDisplacement) const;
+
+  /// x(i) = sum_b w_ib (c_b + Q_b (X_i + u_i - c0_b)): the nodes' current positions.
+  void positions(const ExecSpace& exec, const ConstReal3View& reference, const ConstRealView& relative,
+                 const Real3View& x) const;
+
+  /// relative(i) = sum_b w_ib Q_b^T global(i): nodal forces into the frames the FEM is solved in.
+  void toFrames(const ExecSpace& exec, const ConstReal3View& global, const Real3View& relative) const;
+
+  /// Force and moment (about `centre`) on body `slot` of nodal forces f at positions x, each
+  /// node's share by its weight for the body. Returns {Fx, Fy, Fz, Mx, My, Mz}.
+  std::array<double, 6> nodeLoad(const ExecSpace& exec, int slot, const std::array<double, 3>& centre,
+                                 const ConstReal3View& x, const ConstReal3View& f) const;
 
   /// Force and moment (about `centre`) on body `slot` of the element loads F_e = p_e S_f (S_f the
   /// area vector of the element's fluid face f = front(e) + nInternalFaces, what the membrane

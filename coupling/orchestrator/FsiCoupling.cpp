@@ -191,9 +191,6 @@ void FsiCoupling::setUpParents(const SceneConfig& section) {
                                                didYouMean(pp.membrane, membraneNames) +
                                                "; membranes: " + joinList(membraneNames));
     Panel& p = panels_[static_cast<std::size_t>(it - membraneNames.begin())];
-    if (options_.viscousTraction)
-      throw InputError(section.where("viscousTraction"),
-                       "viscousTraction with membranes mounted on bodies (parentBodyPatches) is not supported yet");
     if (p.wallVelocity)
       throw InputError(section.where(key), "the fluid walls of " + pp.membrane +
                                                " must take the mesh velocity on a moving frame: make them "
@@ -218,6 +215,12 @@ void FsiCoupling::setUpParents(const SceneConfig& section) {
     p.parents = coupling::ParentFrames(p.module->solver().mesh().hostPoints(), candidates, candidateBody,
                                        static_cast<int>(bodies_.size()));
     p.mounted = true;
+    if (options_.viscousTraction) {  // the FEM takes the viscous forces in its frames
+      const lid_t n = p.module->solver().mesh().nNodes();
+      p.forceFrame = Real3View("mfsi::coupling::viscousForceInFrames", n);
+      p.nodePosition = Real3View("mfsi::coupling::mountedNodePosition", n);
+      p.module->solver().loads().nodeForce = p.forceFrame;
+    }
   }
 }
 
@@ -298,6 +301,7 @@ void FsiCoupling::updateLoads(double scale, bool relax, double dt) {
         "mfsi::coupling::forceRelaxation", RangePolicy(exec_, 0, p.iface.nNodes()), KOKKOS_LAMBDA(lid_t i) {
           for (int k = 0; k < 3; ++k) force(i, k) = w * force(i, k) + (1 - w) * fprev(i, k);
         });
+    if (p.mounted) p.parents.toFrames(exec_, p.force, p.forceFrame);
   }
   updateBodyLoads(scale);
   const SolverComm comm;
@@ -331,6 +335,15 @@ void FsiCoupling::updateBodyLoads(double scale) {
       for (int k = 0; k < 3; ++k) {
         force[k] += L[k];
         moment[k] += L[3 + k];
+      }
+      if (!options_.viscousTraction) continue;
+      // The viscous nodal forces (relaxed, as the membrane receives them) at the nodes' positions.
+      p.parents.positions(exec_, p.module->solver().mesh().referencePoints(), p.iterate, p.nodePosition);
+      const std::array<double, 6> V = p.parents.nodeLoad(exec_, static_cast<int>(slot), {c[0], c[1], c[2]},
+                                                         p.nodePosition, p.force);
+      for (int k = 0; k < 3; ++k) {
+        force[k] += V[k];
+        moment[k] += V[3 + k];
       }
     }
     sys.setExternalLoad(b.index, force, moment);

@@ -105,6 +105,8 @@ class FsiCoupling final : public Module {
     bool wallVelocity = false;  ///< the fluid takes the membrane velocity (External walls)
     RealView load, loadPrevious;  ///< element pressure in use, and of the previous iteration
     Real3View force, forcePrevious;  ///< viscous nodal forces in use, and of the previous iteration
+    Real3View forceFrame;    ///< mounted: `force` rotated into the frames (what its FEM receives)
+    Real3View nodePosition;  ///< mounted: the nodes' current positions (the viscous forces' moments)
     Real3View faceVelocity;
     RealView iterate;  ///< this panel's slice of an interface iterate on the device (3 per node)
     Eigen::Index offset = 0;
