@@ -57,6 +57,35 @@ void ParentFrames::setTransforms(const std::vector<RigidPlacement>& transforms) 
   Kokkos::deep_copy(frames_, h);
 }
 
+namespace {
+
+/// x = sum_b w_ib (c_b + Q_b (X_i + u_i - c0_b)): where node i sits.
+template <class Weights, class Frames>
+KOKKOS_INLINE_FUNCTION void placedNode(const Weights& W, const Frames& F, int nb, lid_t i, const ConstReal3View& X,
+                                       const ConstRealView& u, real x[3]) {
+  x[0] = x[1] = x[2] = 0;
+  for (int b = 0; b < nb; ++b) {
+    const real w = W(i, b);
+    if (w == 0) continue;
+    real r[3];
+    for (int k = 0; k < 3; ++k) r[k] = X(i, k) + u(3 * i + k) - F(b, k);
+    for (int k = 0; k < 3; ++k)
+      x[k] += w * (F(b, 3 + k) + F(b, 6 + 3 * k) * r[0] + F(b, 7 + 3 * k) * r[1] + F(b, 8 + 3 * k) * r[2]);
+  }
+}
+
+/// acc += (F, r x F).
+KOKKOS_INLINE_FUNCTION void addForceAndMoment(blas::Sums<6>& acc, const real F[3], const real r[3]) {
+  acc[0] += F[0];
+  acc[1] += F[1];
+  acc[2] += F[2];
+  acc[3] += r[1] * F[2] - r[2] * F[1];
+  acc[4] += r[2] * F[0] - r[0] * F[2];
+  acc[5] += r[0] * F[1] - r[1] * F[0];
+}
+
+}  // namespace
+
 void ParentFrames::displacement(const ExecSpace& exec, const ConstReal3View& reference, const ConstRealView& relative,
                                 const ConstIndexView& fluidNode, const Real3View& meshDisplacement) const {
   const auto W = weights_;
@@ -66,15 +95,8 @@ void ParentFrames::displacement(const ExecSpace& exec, const ConstReal3View& ref
       "mfsi::coupling::parentFrames::displacement", RangePolicy(exec, 0, static_cast<lid_t>(weights_.extent(0))),
       KOKKOS_LAMBDA(lid_t i) {
         if (fluidNode(i) < 0) return;  // not on this rank's part of the mesh
-        real x[3] = {0, 0, 0};
-        for (int b = 0; b < nb; ++b) {
-          const real w = W(i, b);
-          if (w == 0) continue;
-          real r[3];
-          for (int k = 0; k < 3; ++k) r[k] = reference(i, k) + relative(3 * i + k) - F(b, k);
-          for (int k = 0; k < 3; ++k)
-            x[k] += w * (F(b, 3 + k) + F(b, 6 + 3 * k) * r[0] + F(b, 7 + 3 * k) * r[1] + F(b, 8 + 3 * k) * r[2]);
-        }
+        real x[3];
+        placedNode(W, F, nb, i, reference, relative, x);
         for (int k = 0; k < 3; ++k) meshDisplacement(fluidNode(i), k) = x[k] - reference(i, k);
       });
 }
@@ -87,15 +109,8 @@ void ParentFrames::positions(const ExecSpace& exec, const ConstReal3View& refere
   Kokkos::parallel_for(
       "mfsi::coupling::parentFrames::positions", RangePolicy(exec, 0, static_cast<lid_t>(weights_.extent(0))),
       KOKKOS_LAMBDA(lid_t i) {
-        real y[3] = {0, 0, 0};
-        for (int b = 0; b < nb; ++b) {
-          const real w = W(i, b);
-          if (w == 0) continue;
-          real r[3];
-          for (int k = 0; k < 3; ++k) r[k] = reference(i, k) + relative(3 * i + k) - F(b, k);
-          for (int k = 0; k < 3; ++k)
-            y[k] += w * (F(b, 3 + k) + F(b, 6 + 3 * k) * r[0] + F(b, 7 + 3 * k) * r[1] + F(b, 8 + 3 * k) * r[2]);
-        }
+        real y[3];
+        placedNode(W, F, nb, i, reference, relative, y);
         for (int k = 0; k < 3; ++k) x(i, k) = y[k];
       });
 }
@@ -130,12 +145,7 @@ std::array<double, 6> ParentFrames::nodeLoad(const ExecSpace& exec, int slot, co
         if (w == 0) return;
         const real F[3] = {w * f(i, 0), w * f(i, 1), w * f(i, 2)};
         const real r[3] = {x(i, 0) - cx, x(i, 1) - cy, x(i, 2) - cz};
-        acc[0] += F[0];
-        acc[1] += F[1];
-        acc[2] += F[2];
-        acc[3] += r[1] * F[2] - r[2] * F[1];
-        acc[4] += r[2] * F[0] - r[0] * F[2];
-        acc[5] += r[0] * F[1] - r[1] * F[0];
+        addForceAndMoment(acc, F, r);
       });
 }
 
@@ -162,12 +172,7 @@ std::array<double, 6> ParentFrames::bodyLoad(const ExecSpace& exec, int slot, co
         const real w = elementPressure(e) * share / real(nn);
         const real F[3] = {w * faceArea(f, 0), w * faceArea(f, 1), w * faceArea(f, 2)};
         const real r[3] = {faceCentroid(f, 0) - cx, faceCentroid(f, 1) - cy, faceCentroid(f, 2) - cz};
-        acc[0] += F[0];
-        acc[1] += F[1];
-        acc[2] += F[2];
-        acc[3] += r[1] * F[2] - r[2] * F[1];
-        acc[4] += r[2] * F[0] - r[0] * F[2];
-        acc[5] += r[0] * F[1] - r[1] * F[0];
+        addForceAndMoment(acc, F, r);
       });
 }
 
