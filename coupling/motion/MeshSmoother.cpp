@@ -121,18 +121,19 @@ void localFlags(const HexMesh& part, const Kokkos::View<std::uint8_t*, MemSpace>
   Kokkos::deep_copy(slide, hs);
 }
 
-/// Throws unless every owned node of `part` has as many edges as in the whole mesh.
-void checkOwnedRows(const HexMesh& part, const HexMesh& whole) {
+/// The global id of an owned node of `part` with fewer edges than in the whole mesh, or -1; the
+/// same answer on every rank of `comm` (the largest such id), so every rank stops together.
+long long incompleteRow(const HexMesh& part, const HexMesh& whole, MPI_Comm comm) {
   auto gid = Kokkos::create_mirror_view_and_copy(HostSpace(), part.nodeGlobalIds());
   auto po = Kokkos::create_mirror_view_and_copy(HostSpace(), part.nodeNodeOffsets());
   auto wo = Kokkos::create_mirror_view_and_copy(HostSpace(), whole.nodeNodeOffsets());
-  for (lid_t i = 0; i < part.nOwnedNodes(); ++i) {
+  long long bad = -1;
+  for (lid_t i = 0; i < part.nOwnedNodes() && bad < 0; ++i) {
     const lid_t g = static_cast<lid_t>(gid(i));
-    if (po(i + 1) - po(i) != wo(g + 1) - wo(g))
-      throw InputError("mesh motion on several ranks: node " + std::to_string(g) + " has " +
-                       std::to_string(wo(g + 1) - wo(g)) + " edges in the mesh but " + std::to_string(po(i + 1) - po(i)) +
-                       " on its rank (cells that meet the rank's cells at a node alone); run the scene on one rank");
+    if (po(i + 1) - po(i) != wo(g + 1) - wo(g)) bad = g;
   }
+  MPI_Allreduce(MPI_IN_PLACE, &bad, 1, MPI_LONG_LONG, MPI_MAX, comm);
+  return bad;
 }
 
 }  // namespace
@@ -147,7 +148,11 @@ MeshSmoother::MeshSmoother(const HexMesh& mesh, const MeshSmootherOptions& optio
   MFSI_CHECK(options_.retries >= 0, "mesh motion: retries must be >= 0, got " << options_.retries);
   const lid_t nn = mesh.nNodes();
   if (domain.distributed()) {
-    checkOwnedRows(mesh, whole);
+    const long long bad = incompleteRow(mesh, whole, domain.comm);
+    if (bad >= 0)
+      throw InputError("mesh motion on several ranks: node " + std::to_string(bad) +
+                       " has edges in cells its rank does not hold (cells that meet the rank's cells at a node "
+                       "alone); run the scene on one rank");
     Real3View wholeSlide;
     const auto wholeFixed = boundaryNodes(whole, options_.slidingPatches, wholeSlide);
     localFlags(mesh, wholeFixed, wholeSlide, fixed_, slide_);

@@ -72,7 +72,7 @@ class MeshSmoother {
   /// are found, so that a node on the mesh's boundary is prescribed on every rank that holds it,
   /// whichever of its faces the rank has. The owned nodes are smoothed, the ghosts follow their
   /// owners through the node halo, and the quality guard takes the minimum over all ranks. Throws
-  /// InputError when an owned node's edges are not all on its rank (a mesh whose cells meet a
+  /// InputError on every rank when an owned node's edges are not all on its rank (a mesh whose cells meet a
   /// rank's cells at a node alone: the one ghost layer does not complete its row).
   MeshSmoother(const HexMesh& mesh, const MeshSmootherOptions& options, const RankDomain& domain,
                const HexMesh& whole);
