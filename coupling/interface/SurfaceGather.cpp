@@ -111,13 +111,13 @@ SurfaceGather::SurfaceGather(const HexMesh& whole, const HexMesh& part, MPI_Comm
   viscousBack_ = Real3View("mfsi::coupling::surface::viscousBack", nSides_ == 2 ? n : 0);
 }
 
-void SurfaceGather::sumOverRanks(const ExecSpace& exec, const RealView& buffer) const {
+void SurfaceGather::sumOverRanks(const ExecSpace& exec, const RealView& buffer, std::size_t count) const {
   if (comm_ == MPI_COMM_NULL) return;
   exec.fence();
   auto h = Kokkos::create_mirror_view(buffer);
   Kokkos::deep_copy(h, buffer);
   // One contribution per slot, zeros elsewhere: the sum is the owner's value exactly, in any order.
-  MPI_Allreduce(MPI_IN_PLACE, h.data(), static_cast<int>(h.extent(0)), MPI_DOUBLE, MPI_SUM, comm_);
+  MPI_Allreduce(MPI_IN_PLACE, h.data(), static_cast<int>(count), MPI_DOUBLE, MPI_SUM, comm_);
   Kokkos::deep_copy(buffer, h);
 }
 
@@ -143,7 +143,7 @@ void SurfaceGather::gather(const ExecSpace& exec, const fluid::FluidSolver& flui
           for (int c = 0; c < 3; ++c) v[5 + c] = C(f, c);
         });
   }
-  sumOverRanks(exec, buf);
+  sumOverRanks(exec, buf, static_cast<std::size_t>(nSides_ * n * kGeometryWidth));  // a patch has no back slots
   const RealView p = pressure_, am = areaMag_;
   const Real3View a = area_, ce = centroid_;
   Kokkos::parallel_for(
@@ -177,7 +177,7 @@ void SurfaceGather::gatherTraction(const ExecSpace& exec, const fluid::FluidSolv
           for (int c = 0; c < 3; ++c) buf(3 * (base + e) + c) = tv(k, c);
         });
   }
-  sumOverRanks(exec, buf);
+  sumOverRanks(exec, buf, static_cast<std::size_t>(3 * nSides_ * n));  // 3 per slot of the sides there are
   const Real3View front = viscousFront_, back = viscousBack_;
   const bool baffle = nSides_ == 2;
   Kokkos::parallel_for(

@@ -54,7 +54,8 @@ class SurfaceGather {
   void setWallVelocity(const ExecSpace& exec, fluid::FluidSolver& fluid, const ConstReal3View& elementVelocity) const;
 
   /// Public only because nvcc compiles extended device lambdas solely in public members.
-  void sumOverRanks(const ExecSpace& exec, const RealView& buffer) const;
+  /// The first `count` entries of `buffer` summed over the ranks (in place).
+  void sumOverRanks(const ExecSpace& exec, const RealView& buffer, std::size_t count) const;
 
   /// The fluid patches of the surface's sides on this rank and, per face of each, its element.
   struct Side {
