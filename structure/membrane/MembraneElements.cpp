@@ -482,6 +482,39 @@ void membraneLumpedStiffnessItems(const ExecSpace& exec, const MembraneElementDa
   }
 }
 
+real membraneVolumeItems(const ExecSpace& exec, const MembraneElementData& data, lid_t nItems,
+                         const ConstRealView& u, const ItemValuesView& gradient) {
+  const lid_t nE = static_cast<lid_t>(data.elements.extent(0));
+  const MembraneElementData d = data;
+  real volume = 0;
+  Kokkos::parallel_reduce(
+      "mfsi::structure::membrane::volume", RangePolicy(exec, 0, nItems),
+      KOKKOS_LAMBDA(lid_t e, real & v) {
+        for (int i = 0; i < 12; ++i) gradient(e, i) = 0;
+        if (e >= nE) return;
+        lid_t nodes[4];
+        real x[4][3];
+        const int nv = gatherNodes(d.elements, d.X, u, e, nodes, x);
+        for (int gp = 0; gp < gaussCount(nv); ++gp) {
+          real dNds[4][2];
+          for (int a = 0; a < 4; ++a)
+            for (int al = 0; al < 2; ++al) dNds[a][al] = d.dNds(e, gp, a, al);
+          const real w = d.weight(e, gp);
+          real g[2][3], E[3], nrm[3], Nsh[4], xg[3] = {0, 0, 0};
+          strainAt(nv, dNds, x, g, E);
+          cross(g[0], g[1], nrm);
+          shapeAtGauss(nv, gp, Nsh);
+          for (int a = 0; a < nv; ++a)
+            for (int k = 0; k < 3; ++k) xg[k] += Nsh[a] * x[a][k];
+          v += w * dot3(xg, nrm) / 3;
+          for (int a = 0; a < nv; ++a)
+            for (int k = 0; k < 3; ++k) gradient(e, 3 * a + k) += w * Nsh[a] * nrm[k];
+        }
+      },
+      volume);
+  return volume;
+}
+
 void membraneMassItems(const ExecSpace& exec, const MembraneElementData& data, lid_t nItems, bool lumped,
                        const ItemValuesView& mass) {
   const lid_t nE = static_cast<lid_t>(data.elements.extent(0));

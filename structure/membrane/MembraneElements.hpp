@@ -90,6 +90,16 @@ void membraneLumpedStiffnessItems(const ExecSpace& exec, const MembraneElementDa
 void membraneMassItems(const ExecSpace& exec, const MembraneElementData& data, lid_t nItems, bool lumped,
                        const ItemValuesView& mass);
 
+/// \brief The volume function of the deformed surface, V(u) = (1/3) sum_e int x . n da over the
+/// current elements (n along the element normal of the node order), returned, and its gradient
+/// slots dV/dx_A = int N_A n da (elements' rows; line items' rows zero), which is also the
+/// consistent nodal load of a unit follower pressure. For a surface that closes a region with
+/// fixed walls, V(u) - V(0) is the change of the region's volume; 2 x 2 Gauss points integrate a
+/// bilinear quad's x . n da exactly (so it equals the change of the exact trilinear volume of the
+/// hex cells behind a matching fluid mesh), one point a flat triangle's.
+real membraneVolumeItems(const ExecSpace& exec, const MembraneElementData& data, lid_t nItems,
+                         const ConstRealView& u, const ItemValuesView& gradient);
+
 /// \brief Element-centre results: Green-Lagrange strain {E11, E22, 2 E12} and PK2 stress
 /// {S11, S22, S12} (Pa, including the pre-stress T0/h, after wrinkling) in the local basis,
 /// principal stresses s1 >= s2, von Mises, wrinkle state (MembraneWrinkleState as int), and the

@@ -59,6 +59,8 @@ MembraneSolver::MembraneSolver(const MembraneMesh& mesh, const MembraneOptions& 
   v1_ = RealView("mfsi::structure::membrane::v1", n3);
   rhs_ = RealView("mfsi::structure::membrane::dynamicResidual", n3);
   dampingForce_ = RealView("mfsi::structure::membrane::dampingForce", n3);
+  volumeGrad_ = RealView("mfsi::structure::membrane::volumeGradient", n3);
+  volumeDu_ = RealView("mfsi::structure::membrane::volumeDu", n3);
   setupItems();
   setupConstraints();
   setupClamps();
@@ -219,7 +221,9 @@ void MembraneSolver::applyClamps(const RealView& u, real weight) {
 }
 
 void MembraneSolver::updatePressure(real time, real loadFactor) {
-  const real uniform = loadFactor * loads_.pressure * (loads_.pressureTime ? loads_.pressureTime(time) : 1.0);
+  // The volume constraint's multiplier is a reaction, not a load: never scaled by a load factor.
+  const real uniform = loadFactor * loads_.pressure * (loads_.pressureTime ? loads_.pressureTime(time) : 1.0) +
+                       (volume_.active ? volume_.sign * volume_.lambda : 0.0);
   const real ramp = loads_.pressureOffsetRampTime > 0 ? std::min<real>(1, time / loads_.pressureOffsetRampTime) : 1;
   const real offset = loadFactor * loads_.pressureOffset * ramp;
   const bool hasField = loads_.nodePressure.extent(0) > 0;
@@ -344,12 +348,46 @@ real MembraneSolver::maxNodalNorm(const ConstRealView& d) {
   return m;
 }
 
+real MembraneSolver::enclosedVolumeAt(const ConstRealView& u, const RealView& gradient) {
+  if (!haveVolume0_) {
+    blas::fill(exec_, 3 * mesh_.nNodes(), 0.0, work2_);
+    volume0_ = membraneVolumeItems(exec_, data_, nItems_, work2_, itemVec_);
+    haveVolume0_ = true;
+  }
+  const real v = membraneVolumeItems(exec_, data_, nItems_, u, itemVec_);
+  gatherItemVectors(exec_, map_, itemVec_, gradient);
+  if (volume_.sign != 1) blas::axpby(exec_, 3 * mesh_.nNodes(), volume_.sign, gradient, 0.0, gradient);
+  return volume_.sign * (v - volume0_);
+}
+
+real MembraneSolver::enclosedVolume(const ConstRealView& u) { return enclosedVolumeAt(u, volumeGrad_); }
+
+real MembraneSolver::projectOntoVolume(const RealView& u) {
+  const lid_t n3 = 3 * mesh_.nNodes();
+  const real tol = volume_.tolerance * mesh_.referenceArea() * lchar_;
+  Kokkos::deep_copy(exec_, volumeDu_, u);
+  // Newton on the step length along the projected gradient: V is smooth and the moves are small
+  // (a relaxation's second-order volume error), so two or three steps reach round-off.
+  for (int it = 0; it < 20; ++it) {
+    const real c = enclosedVolumeAt(u, volumeGrad_) - volume_.target;
+    if (!std::isfinite(c)) break;
+    if (std::abs(c) <= tol) break;
+    projectConstraints(exec_, constraints_, volumeGrad_, volumeGrad_);
+    const real gg = blas::dot(exec_, SolverComm{}, n3, volumeGrad_, volumeGrad_);
+    MFSI_CHECK(gg > 0, "membrane: the enclosed volume does not change with any free node (volume constraint)");
+    blas::axpy(exec_, n3, -c / gg, volumeGrad_, u);
+  }
+  blas::axpy(exec_, n3, -1.0, u, volumeDu_);
+  return maxNodalNorm(volumeDu_);
+}
+
 // ---------------------------------------------------------------------------------------------
 // Statics
 // ---------------------------------------------------------------------------------------------
 
 MembraneSolveReport MembraneSolver::solveStatic(real time) {
   ScopedRegion region("mfsi::structure::membrane::static");
+  MFSI_CHECK(!volume_.active, "membrane: a volume constraint needs the dynamic step (solveStep), not a static solve");
   const double t0 = wallSeconds();
   time_ = time;
   clampTargets(time);
@@ -692,6 +730,8 @@ MembraneSolveReport MembraneSolver::solveStep(real dt) {
   const real cM = (1 - am) / (beta * dt * dt), cC = (1 - af) * gamma / (beta * dt);
   auto kinematics = [&]() { trialKinematics(); };
   const auto& nopt = options_.newton;
+  const bool constrained = volume_.active;
+  const real volumeTol = volume_.tolerance * mesh_.referenceArea() * lchar_;
   real rel = 1;
   for (int it = 0; it < nopt.maxIterations; ++it) {
     kinematics();
@@ -713,7 +753,10 @@ MembraneSolveReport MembraneSolver::solveStep(real dt) {
     const real scale = std::max({nrm.external, nrm.reaction, inertia, residualFloor() / options_.tolerance});
     rel = scale > 0 ? nrm.free / scale : (nrm.free > 0 ? 1.0 : 0.0);
     rep.relativeResidual = rel;
-    if (rel <= options_.tolerance) {
+    // The volume constraint's residual c and gradient g at the trial displacement.
+    const real volumeMiss = constrained ? enclosedVolumeAt(uTrial_, volumeGrad_) - volume_.target : 0.0;
+    if (!std::isfinite(volumeMiss)) break;
+    if (rel <= options_.tolerance && std::abs(volumeMiss) <= volumeTol) {
       rep.converged = true;
       break;
     }
@@ -744,6 +787,18 @@ MembraneSolveReport MembraneSolver::solveStep(real dt) {
     const real eta = std::min<real>(1e-2, std::max<real>(std::min<real>(rel, 1e-2), 0.5 * options_.tolerance / rel));
     const MembraneCgResult cg = cg_.solve(exec_, K_, constraints_, rhs, du_, eta, nopt.cgMaxIterations);
     rep.linearIterations += cg.iterations;
+    if (constrained) {
+      // du = a + dlambda b with A a = rhs (just solved), A b = (1 - af) g; g . du = -c.
+      blas::axpby(exec_, n3, 1 - af, volumeGrad_, 0.0, volumeGrad_);
+      const MembraneCgResult cgb = cg_.solve(exec_, K_, constraints_, volumeGrad_, volumeDu_, eta, nopt.cgMaxIterations);
+      rep.linearIterations += cgb.iterations;
+      const real ga = blas::dot(exec_, SolverComm{}, n3, volumeGrad_, du_) / (1 - af);
+      const real gb = blas::dot(exec_, SolverComm{}, n3, volumeGrad_, volumeDu_) / (1 - af);
+      if (!(gb > 0)) break;  // the volume does not respond to the free nodes
+      const real dLambda = -(volumeMiss + ga) / gb;
+      blas::axpy(exec_, n3, dLambda, volumeDu_, du_);
+      volume_.lambda += dLambda;
+    }
     blas::axpy(exec_, n3, 1.0, du_, uTrial_);
     ++rep.iterations;
   }
@@ -777,6 +832,7 @@ void MembraneSolver::saveState(io::StateWriter& w) const {
   report.putInt("lineSearchSteps", last_.lineSearchSteps);
   report.putReal("relativeResidual", last_.relativeResidual);
   report.putReal("seconds", last_.seconds);
+  if (volume_.active) w.putReal("volumeMultiplier", volume_.lambda);
   io::StateWriter loads = w.sub("loads");
   if (loads_.nodePressure.extent(0) > 0) loads.putView("nodePressure", loads_.nodePressure);
   if (loads_.elementPressure.extent(0) > 0) loads.putView("elementPressure", loads_.elementPressure);
@@ -797,6 +853,7 @@ void MembraneSolver::loadState(const io::StateReader& r) {
   last_.lineSearchSteps = static_cast<int>(report.integer("lineSearchSteps"));
   last_.relativeResidual = report.real("relativeResidual");
   last_.seconds = report.real("seconds");
+  if (volume_.active && r.has("volumeMultiplier")) volume_.lambda = r.real("volumeMultiplier");
   const io::StateReader loads = r.sub("loads");
   if (loads.has("nodePressure")) {
     if (loads_.nodePressure.extent(0) == 0)

@@ -49,6 +49,22 @@ struct MembraneResults {
 std::vector<MembraneNodeSpring> makeAnchorSprings(const MembraneMesh& mesh, const std::vector<lid_t>& nodes,
                                                   real stiffness);
 
+/// \brief A volume constraint on the implicit step: the membrane closes a region of incompressible
+/// fluid whose volume change the inflow dictates. The step then also solves for one multiplier
+/// lambda, a uniform follower pressure from the region's side, so that the region's volume change
+/// from the reference configuration, sign * (V(u) - V(0)) (membraneVolumeItems), equals `target`
+/// at the end of the step. Newton on (u, lambda): two solves with the step's matrix A per
+/// iteration (A a = r, A b = (1 - af) g, g = dV/du) and dlambda = -(c + g.a) / (g.b).
+struct MembraneVolumeConstraint {
+  bool active = false;
+  /// +1: the region lies on the side the element normals point away from (its pressure pushes
+  /// along them, and it grows as the membrane moves along them); -1: the other side.
+  real sign = 1;
+  real target = 0;        ///< the region's volume change at the end of the step [m^3 for a 3D mesh]
+  real lambda = 0;        ///< the multiplier [Pa]: solved; the next solve starts from it
+  real tolerance = 1e-12;  ///< |volume change - target| <= tolerance * A0 * lchar (A0 the reference area)
+};
+
 /// \brief One membrane: mesh, options, boundary, loads and state.
 class MembraneSolver {
  public:
@@ -86,6 +102,16 @@ class MembraneSolver {
   void commitStep();
   /// \brief Forget the trial state (the next solveStep starts from the predictor).
   void discardStep();
+
+  /// The volume constraint of `solveStep` (inactive by default). Static solves refuse an active one.
+  MembraneVolumeConstraint& volumeConstraint() { return volume_; }
+  const MembraneVolumeConstraint& volumeConstraint() const { return volume_; }
+  /// sign * (V(u) - V(0)): the constrained region's volume change at displacement u.
+  real enclosedVolume(const ConstRealView& u);
+  /// \brief Move u along the (constrained) volume gradient until enclosedVolume(u) = target to the
+  /// constraint's tolerance (a relaxed FSI iterate the fluid must be able to follow). Returns the
+  /// largest nodal move.
+  real projectOntoVolume(const RealView& u);
 
   real time() const { return time_; }
   void setTime(real t) { time_ = t; }
@@ -168,6 +194,8 @@ class MembraneSolver {
   void trialKinematics();
   real maxNodalNorm(const ConstRealView& d);
 
+  /// sign * (V(u) - V(0)) and, into `gradient` (3 per node), its gradient sign * dV/du.
+  real enclosedVolumeAt(const ConstRealView& u, const RealView& gradient);
   MembraneSolveReport newtonSolve(real time, real loadFactor);
   MembraneSolveReport lumpedSolve(real time, real loadFactor);
 
@@ -201,6 +229,10 @@ class MembraneSolver {
   ItemValuesView itemVec_, itemExt_, itemMat_;
   RealView u_, v_, a_, R_, Fext_, du_, uTrial_, work_, work2_, rn_, lumpedMass_, pNode_, offsetSign_;
   RealView a1_, v1_, rhs_, dampingForce_;  ///< time-step work vectors
+  MembraneVolumeConstraint volume_;
+  real volume0_ = 0;      ///< V(0)
+  bool haveVolume0_ = false;
+  RealView volumeGrad_, volumeDu_;  ///< g and b of the constrained Newton step
   RealView pElem_, pElemScaled_;  ///< element pressure in use (the load field, or a scaled copy)
   // Clamps: node ids, reference-frame targets at the requested time, start values of a load ramp.
   IndexView clampNodes_;
