@@ -7,6 +7,7 @@
 #include <algorithm>
 #include <cmath>
 #include <iterator>
+#include <sstream>
 #include <string>
 #include <utility>
 
@@ -1617,6 +1618,24 @@ void FluidSolver::correctFluxAndVelocity(bool flux) {
   if (boundaryVelocityReadsU_) updateBoundaryVelocity();
 }
 
+real FluidSolver::prescribedInflow() const {
+  ConstIndexView kind = bc_.kind();
+  ConstReal3View bv = bc_.velocity();
+  ConstReal3View sf = geo_.faceArea;
+  ConstIndexView own = mesh_.faceOwner();
+  const lid_t nIn = nIn_, nRows = nRows_;
+  real q = 0;
+  Kokkos::parallel_reduce(
+      "mfsi::fluid::prescribedInflow", RangePolicy(exec_, 0, nB_),
+      KOKKOS_LAMBDA(lid_t b, real & s) {
+        const lid_t f = b + nIn;
+        if (kind(b) != kFaceVelocity || own(f) >= nRows) return;  // a ghost's face is its owner's
+        s -= bv(b, 0) * sf(f, 0) + bv(b, 1) * sf(f, 1) + bv(b, 2) * sf(f, 2);
+      },
+      q);
+  return comm_.globalSum(q);
+}
+
 bool FluidSolver::compressible() const {
   return opt_.artificialCompressibility.soundSpeed > 0 && opt_.timeScheme != TimeScheme::Steady;
 }
@@ -1790,8 +1809,46 @@ void FluidSolver::finishFinalPressureSolve() {
   dpFinalValid_ = true;
 }
 
+void FluidSolver::checkClosedDomainBalance() {
+  // In a domain no boundary opens to a pressure, incompressibility asks the boundary fluxes
+  // (inflows and the moving walls' mesh fluxes) to sum to zero; the pressure equation has no
+  // solution otherwise, and a pinned reference cell would swallow the difference as a mass source.
+  ConstIndexView own = mesh_.faceOwner();
+  ConstRealView phi = phi_;
+  const lid_t nIn = nIn_, nRows = nRows_;
+  real sum = 0, mag = 0;
+  Kokkos::parallel_reduce(
+      "mfsi::fluid::closedDomainBalance", RangePolicy(exec_, 0, nB_),
+      KOKKOS_LAMBDA(lid_t b, real & s, real & m) {
+        const lid_t f = b + nIn;
+        if (own(f) >= nRows) return;
+        s += phi(f);
+        m += kmath::fabs(phi(f));
+      },
+      sum, mag);
+  ConstRealView V = geo_.cellVolume;
+  real volume = 0;
+  Kokkos::parallel_reduce(
+      "mfsi::fluid::closedDomainVolume", RangePolicy(exec_, 0, nRows_),
+      KOKKOS_LAMBDA(lid_t c, real & v) { v += V(c); }, volume);
+  sum = comm_.globalSum(sum);
+  mag = comm_.globalSum(mag);
+  volume = comm_.globalSum(volume);
+  // Round-off of the fluxes, and a volume change of 1e-12 of the domain per step (what a
+  // volume-constrained membrane leaves), are balance.
+  if (!(std::abs(sum) <= 1e-6 * mag + 1e-12 * volume / dt_)) {
+    std::ostringstream os;
+    os << "fluid: the domain is closed (no boundary prescribes the pressure) but its boundary fluxes do not balance "
+       << "in the step to t = " << t_ + dt_ << ": net outflow " << sum << " m^3/s against " << mag
+       << " m^3/s through the boundary; an incompressible fluid has no answer (a membrane closing it needs "
+       << "coupling.volumeConstraint, or give the fluid a pressure boundary or fluid.soundSpeed)";
+    throw DivergenceError(os.str());
+  }
+}
+
 StepResult FluidSolver::solve() {
   ScopedRegion region("mfsi::fluid::solve");
+  if (closedDomain()) checkClosedDomainBalance();
   StepResult res;
   const auto& pim = opt_.pimple;
   ConstRealView V = geo_.cellVolume;

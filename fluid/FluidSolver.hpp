@@ -152,6 +152,19 @@ class FluidSolver {
   const Halo* cellHalo() const { return cellHalo_.get(); }
   /// Number of `beginStep` calls so far.
   int stepIndex() const { return nSteps_; }
+  /// \brief The weights of the current step's mesh flux, phi^m = (c1 dV^{n+1} - c00 dV^n) / dt
+  /// per face (dV the swept volumes of this and of the last step; set by beginStep).
+  struct MeshFluxWeights {
+    real c1 = 1, c00 = 0, dt = 1;
+  };
+  MeshFluxWeights meshFluxWeights() const { return {c1_, c00_, dt_}; }
+  /// \brief Volume flow into the domain through the prescribed-velocity and flow-rate faces at the
+  /// end of the current step [m^3/s], summed over the ranks: what the moving walls of a domain
+  /// closed to pressure must make room for.
+  real prescribedInflow() const;
+  /// True when no boundary face prescribes the pressure and the fluid is incompressible: the
+  /// domain is closed, and a reference cell fixes the pressure level.
+  bool closedDomain() const { return pinsPressureLevel(); }
 
  public:
   // --- the steps of solve() ----------------------------------------------------------------
@@ -208,6 +221,8 @@ class FluidSolver {
   PressureRow pressureRow(bool stored) const;
   void assemblePressureMatrixFaces();
   void pinPressureLevel();
+  /// A closed domain: throws DivergenceError when the boundary fluxes do not sum to zero.
+  void checkClosedDomainBalance();
   bool fusedPressureSource() const;
   /// The fused per-cell pressure-matrix and end-of-step passes apply (Gather reduction).
   bool fusedCellPasses() const;

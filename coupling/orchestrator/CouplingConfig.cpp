@@ -128,6 +128,12 @@ Schema couplingSchema() {
                           "fluid's answer depends on the interface alone)",
                           {"lastIterate", "stepStart"}),
            Default("lastIterate"))
+      .key("volumeConstraint",
+           Schema::boolean("when the fluid is incompressible and no boundary prescribes its pressure (a closed "
+                           "chamber), the membrane patch that closes it solves each step with a volume constraint: "
+                           "one multiplier, a uniform pressure, makes its swept volume equal the inflow, so the fluid "
+                           "always has a consistent answer; false: plain Dirichlet-Neumann coupling"),
+           Default(o.volumeConstraint))
       .key("viscousTraction",
            Schema::boolean("load the membranes with the fluid's viscous traction too (nodal forces), not the "
                            "pressure alone"),
@@ -180,6 +186,7 @@ CouplingOptions readCouplingOptions(const SceneConfig& c) {
   o.pClamp = c.get<double>("pClamp");
   o.outsidePressure = c.get<double>("outsidePressure");
   o.viscousTraction = c.get<bool>("viscousTraction");
+  o.volumeConstraint = c.get<bool>("volumeConstraint");
   o.fluidFromStepStart = c.get<std::string>("fluidStart") == "stepStart";
   o.maxMeshVelocity = c.get<double>("maxMeshVelocity");
   o.maxDeltaDispFrac = c.get<double>("maxDeltaDispFrac");

@@ -19,6 +19,7 @@
 ///   fsiStartTime: 0         # structure frozen before this time
 ///   fsiRampTime: 0          # load ramp 0 -> 100 % after fsiStartTime
 ///   outsidePressure: 0      # pressure behind a membrane that replaces a wall patch
+///   volumeConstraint: true  # a membrane closing an incompressible fluid with no pressure boundary keeps its volume in step with the inflow
 ///   meshMotion: {sweeps: 50, minScaledJacobian: 0.05}
 ///   bodyPatches: {piston: [pistonFace]}   # rigid bodies (the `bodies` section) and the fluid patches they carry
 ///   parentBodyPatches: {sail: [mast]}     # membranes mounted on those bodies (nearest listed patch)
@@ -61,6 +62,9 @@ struct CouplingOptions {
   /// characteristic length sqrt(reference area) (0: off): the seed's bow-limiter.
   double maxDeltaDispFrac = 0;
   bool viscousTraction = false;  ///< add the fluid's viscous traction to the membrane loads
+  /// A fluid domain with no pressure boundary (incompressible): the membrane patch that closes it
+  /// solves with a volume constraint (coupling/interface/ChamberRegions).
+  bool volumeConstraint = true;
   /// Every coupling iteration's fluid solve starts from the step's start iterate (true) instead of
   /// the last iteration's answer: the fluid's answer is then a function of the interface alone,
   /// also where the fluid does not converge within its outer iterations.

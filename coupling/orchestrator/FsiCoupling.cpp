@@ -1,5 +1,7 @@
 #include "coupling/orchestrator/FsiCoupling.hpp"
 
+#include "coupling/interface/ChamberRegions.hpp"
+
 #include "core/io/HostCopy.hpp"
 
 #include "core/Error.hpp"
@@ -112,6 +114,7 @@ FsiCoupling::FsiCoupling(const CouplingOptions& options, const SceneConfig& sect
   }
   setUpBodies(section, layout);
   setUpParents(section);
+  setUpChamber(section);
   smoother_ = comm_ != MPI_COMM_NULL
                   ? std::make_unique<coupling::MeshSmoother>(mesh_, options_.motion, *domain, whole_)
                   : std::make_unique<coupling::MeshSmoother>(mesh_, options_.motion);
@@ -127,6 +130,79 @@ FsiCoupling::FsiCoupling(const CouplingOptions& options, const SceneConfig& sect
     smoother_->setMovingNodes(moving);
   }
   acceleration_ = coupling::makeAcceleration(options_.acceleration, layout);
+}
+
+void FsiCoupling::setUpChamber(const SceneConfig& section) {
+  if (!options_.volumeConstraint) return;
+  const fluid::FluidSolver& f = fluid_->solver();
+  std::vector<std::string> pressure;
+  for (const auto& [name, bc] : f.options().boundaries)
+    if (bc.type == fluid::BoundaryType::FixedPressure || bc.type == fluid::BoundaryType::Resistance)
+      pressure.push_back(name);
+  const coupling::ChamberRegions regions = coupling::findChamberRegions(whole_, pressure);
+  const bool anyClosed = std::find(regions.closed.begin(), regions.closed.end(), 1) != regions.closed.end();
+  if (!anyClosed) return;
+  // A region of incompressible fluid walled in beside an open one would need a pressure level of
+  // its own in the fluid; several closed regions, one each. Neither is built yet.
+  const auto where = section.where("volumeConstraint");
+  if (!f.closedDomain()) {
+    if (pressure.empty()) return;  // artificial compressibility: the fluid takes the volume change itself
+    throw InputError(where, "a closed region of fluid (no pressure boundary) lies beside an open one: not supported "
+                            "yet (its pressure level would be undefined); give it a pressure boundary, artificial "
+                            "compressibility (fluid.soundSpeed), or set coupling.volumeConstraint: false");
+  }
+  if (regions.count > 1)
+    throw InputError(where, "the fluid mesh falls into " + std::to_string(regions.count) +
+                                " closed regions (a membrane baffle across it?): a volume constraint per region is "
+                                "not supported yet; set coupling.volumeConstraint: false or use artificial "
+                                "compressibility (fluid.soundSpeed)");
+  // The membrane patches close the domain (a baffle inside it has fluid on both sides and sweeps
+  // no net volume).
+  for (std::size_t i = 0; i < panels_.size(); ++i) {
+    const Panel& p = panels_[i];
+    if (p.iface.side != coupling::InterfaceSide::Patch) continue;
+    if (chamber_.panel >= 0)
+      throw InputError(where, "the closed fluid domain is bounded by two membranes (" +
+                                  panels_[chamber_.panel].module->name() + " and " + p.module->name() +
+                                  "): one volume constraint shared by several membranes is not supported yet");
+    if (!p.dynamic)
+      throw InputError(where, p.module->name() + " closes the fluid domain: its volume constraint needs the dynamic "
+                              "analysis (membranes.N.analysis: dynamic)");
+    if (p.mounted)
+      throw InputError(where, p.module->name() + " closes the fluid domain on moving bodies: a volume constraint "
+                              "for a mounted membrane is not supported yet");
+    chamber_.panel = static_cast<int>(i);
+  }
+  if (chamber_.panel < 0) return;
+  MembraneSolver& s = panels_[chamber_.panel].module->solver();
+  // The membrane's element normals are the fluid faces' outward area vectors
+  // (coupling/interface/MembraneInterface): the domain grows along them.
+  MembraneVolumeConstraint& vc = s.volumeConstraint();
+  vc.active = true;
+  vc.sign = 1;
+  vc.lambda = 0;
+  chamber_.volumeStart = s.enclosedVolume(s.displacement());
+  vc.target = chamber_.volumeStart;
+}
+
+void FsiCoupling::beginChamberStep() {
+  if (chamber_.panel < 0) return;
+  // Every boundary face's flux sums to zero: the membrane's mesh flux (c1 dV^{n+1} - c00 dV^n) / dt
+  // equals the prescribed inflow Q at t_n+1.
+  const fluid::FluidSolver& f = fluid_->solver();
+  const fluid::FluidSolver::MeshFluxWeights w = f.meshFluxWeights();
+  const double q = f.prescribedInflow();
+  last_.volumeStep = (w.dt * q + w.c00 * chamber_.sweptLast) / w.c1;
+  panels_[chamber_.panel].module->solver().volumeConstraint().target = chamber_.volumeStart + last_.volumeStep;
+}
+
+void FsiCoupling::checkChamberVolume(const InterfaceVector& x) {
+  if (chamber_.panel < 0) return;
+  Panel& p = panels_[chamber_.panel];
+  MembraneSolver& s = p.module->solver();
+  toDevice(x, p.offset, p.iterate);
+  const double miss = std::abs(s.enclosedVolume(p.iterate) - s.volumeConstraint().target);
+  last_.volumeMiss = std::max(last_.volumeMiss, miss);
 }
 
 void FsiCoupling::setUpBodies(const SceneConfig& section, std::vector<coupling::InterfaceBlock>& layout) {
@@ -383,11 +459,20 @@ void FsiCoupling::gatherTrial(InterfaceVector& xt) const {
   if (!bodies_.empty()) xt.segment(bodyOffset_, rigid_->system().nDof()) = rigid_->system().q();
 }
 
-void FsiCoupling::setTrial(const InterfaceVector& x) {
-  for (Panel& p : panels_) {
+void FsiCoupling::setTrial(InterfaceVector& x) {
+  for (std::size_t i = 0; i < panels_.size(); ++i) {
+    Panel& p = panels_[i];
     MembraneSolver& s = p.module->solver();
     if (p.dynamic) {
       toDevice(x, p.offset, p.iterate);
+      if (static_cast<int>(i) == chamber_.panel) {
+        // A relaxed iterate misses the volume to second order in its update: the fluid must get one
+        // it can follow.
+        s.projectOntoVolume(p.iterate);
+        toHost(p.iterate, x, p.offset);
+        last_.volumeMiss =
+            std::max(last_.volumeMiss, std::abs(s.enclosedVolume(p.iterate) - s.volumeConstraint().target));
+      }
       s.setTrialDisplacement(p.iterate);
     } else {
       toDevice(x, p.offset, s.displacement());
@@ -528,6 +613,7 @@ void FsiCoupling::advance(const TimeState& t) {
     // The structure is frozen and the mesh fixed until fsiStartTime.
     solveFluid(t);
     for (Panel& p : panels_) p.module->solver().setTime(t1);
+    chamber_.sweptLast = 0;
     fluid_->endStep();
     last_.converged = true;
     ++steps_;
@@ -546,8 +632,10 @@ void FsiCoupling::advance(const TimeState& t) {
   // The structure goes first, on the loads of t_n: its answer is the predictor x_1 (and the whole
   // step's answer in the explicit scheme). It is not a value of the fixed-point map of this step
   // (the fluid has not seen t_n+1 yet), so it never enters the acceleration's history.
+  beginChamberStep();
   solveStructure(t1, t.dt);
   gatherTrial(x);
+  checkChamberVolume(x);
   double smallestResidual = std::numeric_limits<double>::infinity();
   for (;;) {
     // An iterate the mesh cannot follow (a quasi-Newton step too far) is cut back towards the last
@@ -558,6 +646,7 @@ void FsiCoupling::advance(const TimeState& t) {
     if (!implicit) break;
     solveStructure(t1, t.dt);
     gatherTrial(xt);
+    checkChamberVolume(xt);
     const double nx = acceleration_->norm(xt), nr = acceleration_->norm(xt - x);
     last_.displacementResidual = nx > 0 ? nr / nx : nr;
     last_.forceResidual = forceResidual_;
@@ -591,6 +680,28 @@ void FsiCoupling::advance(const TimeState& t) {
   // Converged (or explicit): the structure's last answer is committed; the fluid saw the mesh at x,
   // within fsiTol of it. Not converged: the last relaxed iterate, which the mesh and fluid match.
   if (!last_.converged && implicit) setTrial(x);
+  if (chamber_.panel >= 0) {
+    // The fluid mesh ends the step at `good` (the last iterate moved to): the next step's start.
+    Panel& p = panels_[chamber_.panel];
+    MembraneSolver& s = p.module->solver();
+    toDevice(good, p.offset, p.iterate);
+    const double v = s.enclosedVolume(p.iterate);
+    chamber_.sweptLast = v - chamber_.volumeStart;
+    chamber_.volumeStart = v;
+    // The fluid's pressure level in a closed domain is that of its reference cell and drifts with
+    // the pressure solver's tolerance; the multiplier takes up the difference, so the pressure on
+    // the membrane is the multiplier plus the fluid's mean load on it.
+    const RealView load = p.load;
+    const std::vector<real>& areas = s.mesh().elementAreas();
+    auto h = Kokkos::create_mirror_view_and_copy(HostSpace(), load);
+    double pa = 0, a = 0;
+    for (std::size_t e = 0; e < areas.size(); ++e) {
+      pa += areas[e] * h(e);
+      a += areas[e];
+    }
+    last_.chamberPressure = s.volumeConstraint().lambda + (a > 0 ? pa / a : 0.0);
+    chamber_.maxMissRun = std::max(chamber_.maxMissRun, last_.volumeMiss);
+  }
   commitStructure();
   advanceLoadFilter();
   fluid_->endStep();
@@ -619,14 +730,17 @@ void FsiCoupling::advance(const TimeState& t) {
 }
 
 std::vector<std::string> FsiCoupling::stepColumns() const {
-  return {"iterations",        "displacementResidual", "forceResidual",    "omega",  "columns",
-          "minScaledJacobian", "cutBacks",             "motionIterations", "limited"};
+  std::vector<std::string> c{"iterations",        "displacementResidual", "forceResidual",    "omega",  "columns",
+                             "minScaledJacobian", "cutBacks",             "motionIterations", "limited"};
+  if (chamber_.panel >= 0) c.insert(c.end(), {"chamberVolumeStep", "chamberVolumeMiss", "chamberPressure"});
+  return c;
 }
 
 void FsiCoupling::appendStepValues(std::vector<double>& v) const {
   v.insert(v.end(), {double(last_.iterations), last_.displacementResidual, last_.forceResidual, last_.omega,
                      double(last_.columns), last_.minScaledJacobian, double(last_.cutBacks),
                      double(last_.motionIterations), double(last_.limited)});
+  if (chamber_.panel >= 0) v.insert(v.end(), {last_.volumeStep, last_.volumeMiss, last_.chamberPressure});
 }
 
 void FsiCoupling::addMetrics(std::map<std::string, double>& m) const {
@@ -637,6 +751,11 @@ void FsiCoupling::addMetrics(std::map<std::string, double>& m) const {
   m["coupling.min_scaled_jacobian"] = minJacobian_;
   m["coupling.cut_backs"] = double(cutBacksTotal_);
   m["coupling.limited_updates"] = double(limitedTotal_);
+  if (chamber_.panel >= 0) {
+    m["coupling.chamber_max_volume_miss"] = chamber_.maxMissRun;
+    m["coupling.chamber_volume"] = chamber_.volumeStart;
+    m["coupling.chamber_pressure"] = last_.chamberPressure;
+  }
   const auto& all = timers_.all();
   auto seconds = [&](const char* k) {
     auto it = all.find(k);
@@ -724,6 +843,9 @@ void FsiCoupling::saveState(io::StateWriter& w) const {
                                         double(l.limited), stepEnd_, forceResidual_, minJacobian_});
   w.put("counters", std::vector<std::int64_t>{steps_, iterationsTotal_, unconvergedSteps_, unconvergedInARow_,
                                               cutBacksTotal_, limitedTotal_, maxIterations_});
+  if (chamber_.panel >= 0)
+    w.put("chamber", std::vector<double>{chamber_.volumeStart, chamber_.sweptLast, chamber_.maxMissRun, l.volumeStep,
+                                         l.volumeMiss, l.chamberPressure});
 }
 
 void FsiCoupling::loadState(const io::StateReader& r) {
@@ -769,6 +891,15 @@ void FsiCoupling::loadState(const io::StateReader& r) {
   cutBacksTotal_ = c[4];
   limitedTotal_ = c[5];
   maxIterations_ = static_cast<int>(c[6]);
+  if (chamber_.panel >= 0) {
+    const auto ch = r.doubles("chamber", 6);
+    chamber_.volumeStart = ch[0];
+    chamber_.sweptLast = ch[1];
+    chamber_.maxMissRun = ch[2];
+    l.volumeStep = ch[3];
+    l.volumeMiss = ch[4];
+    l.chamberPressure = ch[5];
+  }
 }
 
 }  // namespace mfsi

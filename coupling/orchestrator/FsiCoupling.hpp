@@ -24,6 +24,13 @@
 /// the fluid's force and moment on those patches load them; every iteration re-solves their step
 /// from the committed state (RigidBodySystem::solveStep), the step commits once.
 ///
+/// A closed chamber (an incompressible fluid with no pressure boundary, coupling/interface/
+/// ChamberRegions) closed by a membrane patch: the inflow dictates the membrane's swept volume. Each
+/// step the target is the volume the fluid's mesh flux needs, c1 dV = dt Q + c00 dV_last (BDF2
+/// weights), and the membrane solves with a volume constraint (MembraneVolumeConstraint: a uniform
+/// pressure as multiplier); every relaxed iterate is moved back onto the constraint before the
+/// fluid sees it, so the pressure equation is consistent in every coupling iteration.
+///
 /// Membrane state never leaks from one iteration into the next: a dynamic membrane re-solves the
 /// step from its committed state (MembraneSolver::solveStep) and commits once; the fluid re-solves
 /// the step from its current iterate on the moved mesh, its time levels set at beginStep.
@@ -90,6 +97,11 @@ class FsiCoupling final : public Module {
     int cutBacks = 0;  ///< iterates the mesh could not follow, cut back towards the last good one
     int motionIterations = 0;  ///< CG iterations (or Jacobi sweeps) of the step's mesh motions
     int limited = 0;           ///< updates shortened by maxDeltaDispFrac / maxMeshVelocity
+    /// A closed chamber: the largest |volume change - target| of the step's iterates that the fluid
+    /// saw and the structure returned [m^3], the target's change over the step, and the multiplier.
+    double volumeMiss = 0;
+    double volumeStep = 0;
+    double chamberPressure = 0;
   };
   const StepReport& lastStep() const { return last_; }
 
@@ -135,7 +147,14 @@ class FsiCoupling final : public Module {
   void updateBodyLoads(double scale);
   void solveStructure(double t1, double dt);
   void gatherTrial(coupling::InterfaceVector& xt) const;
-  void setTrial(const coupling::InterfaceVector& x);
+  /// The membranes (and bodies) to the iterate x; a membrane that closes a chamber first moves x
+  /// onto its volume constraint (x is updated).
+  void setTrial(coupling::InterfaceVector& x);
+  /// A closed chamber: the step's volume target from the prescribed inflow and the fluid's
+  /// mesh-flux weights.
+  void beginChamberStep();
+  /// |volume change - target| of the chamber membrane at its slice of x, into the step's report.
+  void checkChamberVolume(const coupling::InterfaceVector& x);
   void commitStructure();
   /// maxDeltaDispFrac and maxMeshVelocity: x's move from `previous` is shortened where it exceeds
   /// them (per membrane node; per body, its whole coordinate update). Returns true when it was.
@@ -153,6 +172,7 @@ class FsiCoupling final : public Module {
  private:
   void setUpBodies(const SceneConfig& section, std::vector<coupling::InterfaceBlock>& layout);
   void setUpParents(const SceneConfig& section);
+  void setUpChamber(const SceneConfig& section);
 
   CouplingOptions options_;
   HexMesh& mesh_;
@@ -177,6 +197,14 @@ class FsiCoupling final : public Module {
             limitedTotal_ = 0;
   int maxIterations_ = 0;
   double minJacobian_ = 1;
+  /// The membrane that closes a closed fluid domain, and the volume bookkeeping of its constraint.
+  struct Chamber {
+    int panel = -1;            ///< index into panels_; -1: no constraint
+    double volumeStart = 0;    ///< the chamber's volume change where the fluid mesh is at the step's start
+    double sweptLast = 0;      ///< what the membrane swept in the last step (the BDF2 mesh flux reads it)
+    double maxMissRun = 0;     ///< largest volume miss of the run [m^3]
+  };
+  Chamber chamber_;
 };
 
 /// Catalogue entry of the `coupling` section (needs the `fluid` section and at least one membrane

@@ -1,6 +1,7 @@
 #include "structure/membrane/MembraneElements.hpp"
 
 #include "core/Error.hpp"
+#include "core/HexGeometry.hpp"
 
 namespace mfsi {
 
@@ -500,16 +501,22 @@ real membraneVolumeItems(const ExecSpace& exec, const MembraneElementData& data,
           for (int a = 0; a < 4; ++a)
             for (int al = 0; al < 2; ++al) dNds[a][al] = d.dNds(e, gp, a, al);
           const real w = d.weight(e, gp);
-          real g[2][3], E[3], nrm[3], Nsh[4], xg[3] = {0, 0, 0};
+          real g[2][3], E[3], nrm[3], Nsh[4];
           strainAt(nv, dNds, x, g, E);
           cross(g[0], g[1], nrm);
           shapeAtGauss(nv, gp, Nsh);
           for (int a = 0; a < nv; ++a)
-            for (int k = 0; k < 3; ++k) xg[k] += Nsh[a] * x[a][k];
-          v += w * dot3(xg, nrm) / 3;
-          for (int a = 0; a < nv; ++a)
             for (int k = 0; k < 3; ++k) gradient(e, 3 * a + k) += w * Nsh[a] * nrm[k];
         }
+        double hex[8][3];
+        for (int a = 0; a < 4; ++a) {
+          const int q = a < nv ? a : nv - 1;
+          for (int k = 0; k < 3; ++k) {
+            hex[a][k] = d.X(nodes[q], k);
+            hex[a + 4][k] = x[q][k];
+          }
+        }
+        v += geom::hexVolume(hex);
       },
       volume);
   return volume;

@@ -90,13 +90,14 @@ void membraneLumpedStiffnessItems(const ExecSpace& exec, const MembraneElementDa
 void membraneMassItems(const ExecSpace& exec, const MembraneElementData& data, lid_t nItems, bool lumped,
                        const ItemValuesView& mass);
 
-/// \brief The volume function of the deformed surface, V(u) = (1/3) sum_e int x . n da over the
-/// current elements (n along the element normal of the node order), returned, and its gradient
-/// slots dV/dx_A = int N_A n da (elements' rows; line items' rows zero), which is also the
-/// consistent nodal load of a unit follower pressure. For a surface that closes a region with
-/// fixed walls, V(u) - V(0) is the change of the region's volume; 2 x 2 Gauss points integrate a
-/// bilinear quad's x . n da exactly (so it equals the change of the exact trilinear volume of the
-/// hex cells behind a matching fluid mesh), one point a flat triangle's.
+/// \brief The volume the surface sweeps from its reference to its deformed position, returned:
+/// the sum over elements of the exact volume of the trilinear hex between the reference and the
+/// current quad (a triangle as a quad with its last node repeated), positive along the element
+/// normals. It is what a matching fluid mesh's swept-volume fluxes add up to (fluid/MeshFlux), also
+/// where the surface's free edges slide in planes (a one-cell-thick 2D mesh), and it is additive
+/// over successive moves. Into the gradient slots (elements' rows; line items' rows zero) goes
+/// int N_A n da over the current element, the consistent nodal load of a unit follower pressure:
+/// the volume's gradient in every direction a clamped rim or a motion plane leaves free.
 real membraneVolumeItems(const ExecSpace& exec, const MembraneElementData& data, lid_t nItems,
                          const ConstRealView& u, const ItemValuesView& gradient);
 

@@ -349,15 +349,10 @@ real MembraneSolver::maxNodalNorm(const ConstRealView& d) {
 }
 
 real MembraneSolver::enclosedVolumeAt(const ConstRealView& u, const RealView& gradient) {
-  if (!haveVolume0_) {
-    blas::fill(exec_, 3 * mesh_.nNodes(), 0.0, work2_);
-    volume0_ = membraneVolumeItems(exec_, data_, nItems_, work2_, itemVec_);
-    haveVolume0_ = true;
-  }
   const real v = membraneVolumeItems(exec_, data_, nItems_, u, itemVec_);
   gatherItemVectors(exec_, map_, itemVec_, gradient);
   if (volume_.sign != 1) blas::axpby(exec_, 3 * mesh_.nNodes(), volume_.sign, gradient, 0.0, gradient);
-  return volume_.sign * (v - volume0_);
+  return volume_.sign * v;
 }
 
 real MembraneSolver::enclosedVolume(const ConstRealView& u) { return enclosedVolumeAt(u, volumeGrad_); }

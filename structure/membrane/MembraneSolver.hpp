@@ -52,7 +52,7 @@ std::vector<MembraneNodeSpring> makeAnchorSprings(const MembraneMesh& mesh, cons
 /// \brief A volume constraint on the implicit step: the membrane closes a region of incompressible
 /// fluid whose volume change the inflow dictates. The step then also solves for one multiplier
 /// lambda, a uniform follower pressure from the region's side, so that the region's volume change
-/// from the reference configuration, sign * (V(u) - V(0)) (membraneVolumeItems), equals `target`
+/// from the reference configuration, sign * (the volume swept from it, membraneVolumeItems), equals `target`
 /// at the end of the step. Newton on (u, lambda): two solves with the step's matrix A per
 /// iteration (A a = r, A b = (1 - af) g, g = dV/du) and dlambda = -(c + g.a) / (g.b).
 struct MembraneVolumeConstraint {
@@ -106,7 +106,8 @@ class MembraneSolver {
   /// The volume constraint of `solveStep` (inactive by default). Static solves refuse an active one.
   MembraneVolumeConstraint& volumeConstraint() { return volume_; }
   const MembraneVolumeConstraint& volumeConstraint() const { return volume_; }
-  /// sign * (V(u) - V(0)): the constrained region's volume change at displacement u.
+  /// sign * (the volume the membrane swept from its reference to u): the constrained region's
+  /// volume change at displacement u.
   real enclosedVolume(const ConstRealView& u);
   /// \brief Move u along the (constrained) volume gradient until enclosedVolume(u) = target to the
   /// constraint's tolerance (a relaxed FSI iterate the fluid must be able to follow). Returns the
@@ -194,7 +195,7 @@ class MembraneSolver {
   void trialKinematics();
   real maxNodalNorm(const ConstRealView& d);
 
-  /// sign * (V(u) - V(0)) and, into `gradient` (3 per node), its gradient sign * dV/du.
+  /// enclosedVolume(u) and, into `gradient` (3 per node), its gradient.
   real enclosedVolumeAt(const ConstRealView& u, const RealView& gradient);
   MembraneSolveReport newtonSolve(real time, real loadFactor);
   MembraneSolveReport lumpedSolve(real time, real loadFactor);
@@ -230,8 +231,6 @@ class MembraneSolver {
   RealView u_, v_, a_, R_, Fext_, du_, uTrial_, work_, work2_, rn_, lumpedMass_, pNode_, offsetSign_;
   RealView a1_, v1_, rhs_, dampingForce_;  ///< time-step work vectors
   MembraneVolumeConstraint volume_;
-  real volume0_ = 0;      ///< V(0)
-  bool haveVolume0_ = false;
   RealView volumeGrad_, volumeDu_;  ///< g and b of the constrained Newton step
   RealView pElem_, pElemScaled_;  ///< element pressure in use (the load field, or a scaled copy)
   // Clamps: node ids, reference-frame targets at the requested time, start values of a load ramp.

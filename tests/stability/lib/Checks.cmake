@@ -5,10 +5,13 @@
 # with exit 0 and status ok; every step's coupling loop converged (none unconverged, none over
 # <iterationLimit> iterations); no NaN or Inf anywhere in steps.csv; the mesh valid (minimum scaled
 # Jacobian over the run > ${minJacobian}, default 0.5); the membrane's largest displacement finite
-# and below 0.5 (half the cavity: bounded).
+# and below 0.5 (half the cavity: bounded). The membrane is ${membrane} (default bottom).
 function(stable name steps limit)
   if(NOT DEFINED minJacobian)
     set(minJacobian 0.5)
+  endif()
+  if(NOT DEFINED membrane)
+    set(membrane bottom)
   endif()
   execute_process(COMMAND ${MFSI} run ${ARGN} --out ${WORK}/${name} RESULT_VARIABLE rc OUTPUT_VARIABLE o ERROR_VARIABLE e)
   if(NOT rc EQUAL 0)
@@ -22,7 +25,7 @@ function(stable name steps limit)
   string(JSON worst GET "${s}" metrics coupling.max_iterations)
   string(JSON mean GET "${s}" metrics coupling.mean_iterations)
   string(JSON jac GET "${s}" metrics coupling.min_scaled_jacobian)
-  string(JSON umax GET "${s}" metrics membrane.bottom.maxDisplacement)
+  string(JSON umax GET "${s}" metrics membrane.${membrane}.maxDisplacement)
   if(NOT status STREQUAL "ok" OR NOT done EQUAL steps OR NOT unconverged EQUAL 0 OR worst GREATER limit)
     message(SEND_ERROR "${name}: status ${status}, ${done} of ${steps} steps, ${unconverged} unconverged, "
       "at most ${worst} iterations (limit ${limit})")
