@@ -33,3 +33,20 @@ if(NOT bad EQUAL 0)
   message(SEND_ERROR "balloon: ${line}")
 endif()
 diverges(balloon_unconstrained 400 balloon --set coupling.volumeConstraint=false)
+
+# A restart from a checkpoint continues bitwise (the multiplier and the volume bookkeeping are
+# in the checkpoint): the last row of steps.csv, the wall time left out.
+execute_process(COMMAND ${MFSI} run balloon --set time.endTime=6 --set output.checkpoint.everySteps=50
+  --out ${WORK}/saved RESULT_VARIABLE rc1 OUTPUT_QUIET ERROR_QUIET)
+file(COPY ${WORK}/saved/ DESTINATION ${WORK}/continued)
+execute_process(COMMAND ${MFSI} run --restart ${WORK}/continued/checkpoints/checkpoint_000000100.h5
+  --out ${WORK}/continued RESULT_VARIABLE rc2 OUTPUT_QUIET ERROR_VARIABLE e)
+file(STRINGS ${WORK}/saved/steps.csv a)
+file(STRINGS ${WORK}/continued/steps.csv b)
+list(GET a -1 la)
+list(GET b -1 lb)
+string(REGEX REPLACE "^([^,]*,[^,]*,)[^,]*" "\\1" la "${la}")
+string(REGEX REPLACE "^([^,]*,[^,]*,)[^,]*" "\\1" lb "${lb}")
+if(NOT rc1 EQUAL 0 OR NOT rc2 EQUAL 0 OR NOT la STREQUAL lb OR NOT la MATCHES "^120,")
+  message(SEND_ERROR "balloon restart from step 100 (exit ${rc1}, ${rc2}) ends differently:\n${la}\n${lb}\n${e}")
+endif()
