@@ -1841,7 +1841,7 @@ void FluidSolver::checkClosedDomainBalance() {
     os << "fluid: the domain is closed (no boundary prescribes the pressure) but its boundary fluxes do not balance "
        << "in the step to t = " << t_ + dt_ << ": net outflow " << sum << " m^3/s against " << mag
        << " m^3/s through the boundary; an incompressible fluid has no answer (a membrane closing it needs "
-       << "coupling.volumeConstraint, or give the fluid a pressure boundary or fluid.soundSpeed)";
+       << "coupling.volumeConstraint, or give the fluid a pressure boundary or fluid.artificialSoundSpeed)";
     throw DivergenceError(os.str());
   }
 }

@@ -149,13 +149,13 @@ void FsiCoupling::setUpChamber(const SceneConfig& section) {
     if (pressure.empty()) return;  // artificial compressibility: the fluid takes the volume change itself
     throw InputError(where, "a closed region of fluid (no pressure boundary) lies beside an open one: not supported "
                             "yet (its pressure level would be undefined); give it a pressure boundary, artificial "
-                            "compressibility (fluid.soundSpeed), or set coupling.volumeConstraint: false");
+                            "compressibility (fluid.artificialSoundSpeed), or set coupling.volumeConstraint: false");
   }
   if (regions.count > 1)
     throw InputError(where, "the fluid mesh falls into " + std::to_string(regions.count) +
                                 " closed regions (a membrane baffle across it?): a volume constraint per region is "
                                 "not supported yet; set coupling.volumeConstraint: false or use artificial "
-                                "compressibility (fluid.soundSpeed)");
+                                "compressibility (fluid.artificialSoundSpeed)");
   // The membrane patches close the domain (a baffle inside it has fluid on both sides and sweeps
   // no net volume).
   for (std::size_t i = 0; i < panels_.size(); ++i) {
