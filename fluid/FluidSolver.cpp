@@ -1303,17 +1303,21 @@ void FluidSolver::computePhiHbyA() {
 void FluidSolver::pinPressureLevel() {
   // No boundary sets the level: doubling one diagonal entry (and adding the matching source in
   // finishPressureSource) pins p at the reference cell without changing the other equations.
-  if (referenceRow_ < 0) return;  // another rank's cell
-  const lid_t ref = referenceRow_;
+  // Closed regions beside open ones: one reference row each, at level 0.
   ConstIndexView di = Ap_.diagIdx;
   auto vals = Ap_.values;
   RealView d = pressureLattice_ != nullptr ? pressureLattice_->diagonal() : RealView();
+  ConstIndexView rows = regionPinRows_;
+  const lid_t ref = pinsPressureLevel() ? referenceRow_ : -1;  // -1: another rank's cell, or none
+  const lid_t n = static_cast<lid_t>(rows.extent(0)) + 1;
   Kokkos::parallel_for(
-      "mfsi::fluid::pressure::reference", RangePolicy(exec_, 0, 1), KOKKOS_LAMBDA(lid_t) {
+      "mfsi::fluid::pressure::reference", RangePolicy(exec_, 0, n), KOKKOS_LAMBDA(lid_t i) {
+        const lid_t r = i == 0 ? ref : rows(i - 1);
+        if (r < 0) return;
         if (d.extent(0) > 0)
-          d(ref) *= 2.0;
+          d(r) *= 2.0;
         else
-          vals(di(ref)) *= 2.0;
+          vals(di(r)) *= 2.0;
       });
 }
 
@@ -1524,7 +1528,7 @@ void FluidSolver::assemblePressure(bool matrix) {
     if (matrix) assemblePressureMatrixFaces();
     divergence<1>(exec_, mesh_, fluxP_, rhsP_, opt_.reduction, /*accumulate=*/false, /*sign=*/-1.0);
   }
-  if (matrix && pinsPressureLevel()) pinPressureLevel();
+  if (matrix && pinsAnyLevel()) pinPressureLevel();
   if (matrix && pressureLattice_ != nullptr) linear_.pressureLatticeAssembled(Ap_);
   finishPressureSource();
 }
@@ -1618,8 +1622,38 @@ void FluidSolver::correctFluxAndVelocity(bool flux) {
   if (boundaryVelocityReadsU_) updateBoundaryVelocity();
 }
 
-real FluidSolver::prescribedInflow() const {
+int FluidSolver::addClosedRegion(const std::vector<char>& localCells, long long referenceCell) {
+  MFSI_CHECK(static_cast<lid_t>(localCells.size()) == nCells_,
+             "fluid: addClosedRegion got " << localCells.size() << " flags for " << nCells_ << " cells");
+  const int region = closedRegions_++;
+  if (cellClosedRegion_.extent(0) == 0) {
+    cellClosedRegion_ = IndexView("mfsi::fluid::cellClosedRegion", nCells_);
+    Kokkos::deep_copy(cellClosedRegion_, -1);
+  }
+  auto h = Kokkos::create_mirror_view_and_copy(HostSpace(), cellClosedRegion_);
+  auto gid = Kokkos::create_mirror_view_and_copy(HostSpace(), mesh_.cellGlobalIds());
+  std::vector<lid_t> rows(regionPinRows_.extent(0));
+  Kokkos::deep_copy(Kokkos::View<lid_t*, HostSpace>(rows.data(), rows.size()), regionPinRows_);
+  lid_t found = 0;
+  for (lid_t c = 0; c < nCells_; ++c) {
+    if (!localCells[c]) continue;
+    h(c) = region;
+    if (c < nRows_ && static_cast<long long>(gid(c)) == referenceCell) {
+      rows.push_back(c);
+      found = 1;
+    }
+  }
+  MFSI_CHECK(comm_.globalSum(static_cast<double>(found)) == 1.0,
+             "fluid: the reference cell " << referenceCell << " of a closed region is not one of its cells");
+  Kokkos::deep_copy(cellClosedRegion_, h);
+  regionPinRows_ = IndexView("mfsi::fluid::regionPinRows", rows.size());
+  Kokkos::deep_copy(regionPinRows_, Kokkos::View<lid_t*, HostSpace>(rows.data(), rows.size()));
+  return region;
+}
+
+real FluidSolver::prescribedInflow(int region) const {
   ConstIndexView kind = bc_.kind();
+  ConstIndexView cr = cellClosedRegion_;
   ConstReal3View bv = bc_.velocity();
   ConstReal3View sf = geo_.faceArea;
   ConstIndexView own = mesh_.faceOwner();
@@ -1630,6 +1664,7 @@ real FluidSolver::prescribedInflow() const {
       KOKKOS_LAMBDA(lid_t b, real & s) {
         const lid_t f = b + nIn;
         if (kind(b) != kFaceVelocity || own(f) >= nRows) return;  // a ghost's face is its owner's
+        if (region >= 0 && cr(own(f)) != region) return;
         s -= bv(b, 0) * sf(f, 0) + bv(b, 1) * sf(f, 1) + bv(b, 2) * sf(f, 2);
       },
       q);
@@ -1809,11 +1844,12 @@ void FluidSolver::finishFinalPressureSolve() {
   dpFinalValid_ = true;
 }
 
-void FluidSolver::checkClosedDomainBalance() {
+void FluidSolver::checkClosedDomainBalance(int region) {
   // In a domain no boundary opens to a pressure, incompressibility asks the boundary fluxes
   // (inflows and the moving walls' mesh fluxes) to sum to zero; the pressure equation has no
   // solution otherwise, and a pinned reference cell would swallow the difference as a mass source.
   ConstIndexView own = mesh_.faceOwner();
+  ConstIndexView cr = cellClosedRegion_;
   ConstRealView phi = phi_;
   const lid_t nIn = nIn_, nRows = nRows_;
   real sum = 0, mag = 0;
@@ -1821,7 +1857,7 @@ void FluidSolver::checkClosedDomainBalance() {
       "mfsi::fluid::closedDomainBalance", RangePolicy(exec_, 0, nB_),
       KOKKOS_LAMBDA(lid_t b, real & s, real & m) {
         const lid_t f = b + nIn;
-        if (own(f) >= nRows) return;
+        if (own(f) >= nRows || (region >= 0 && cr(own(f)) != region)) return;
         s += phi(f);
         m += kmath::fabs(phi(f));
       },
@@ -1830,7 +1866,7 @@ void FluidSolver::checkClosedDomainBalance() {
   real volume = 0;
   Kokkos::parallel_reduce(
       "mfsi::fluid::closedDomainVolume", RangePolicy(exec_, 0, nRows_),
-      KOKKOS_LAMBDA(lid_t c, real & v) { v += V(c); }, volume);
+      KOKKOS_LAMBDA(lid_t c, real & v) { v += (region < 0 || cr(c) == region) ? V(c) : 0.0; }, volume);
   sum = comm_.globalSum(sum);
   mag = comm_.globalSum(mag);
   volume = comm_.globalSum(volume);
@@ -1838,7 +1874,8 @@ void FluidSolver::checkClosedDomainBalance() {
   // volume-constrained membrane leaves), are balance.
   if (!(std::abs(sum) <= 1e-6 * mag + 1e-12 * volume / dt_)) {
     std::ostringstream os;
-    os << "fluid: the domain is closed (no boundary prescribes the pressure) but its boundary fluxes do not balance "
+    os << "fluid: " << (region < 0 ? "the domain" : "closed region " + std::to_string(region))
+       << " has no boundary that prescribes the pressure, but its boundary fluxes do not balance "
        << "in the step to t = " << t_ + dt_ << ": net outflow " << sum << " m^3/s against " << mag
        << " m^3/s through the boundary; an incompressible fluid has no answer (a membrane closing it needs "
        << "coupling.volumeConstraint, or give the fluid a pressure boundary or fluid.artificialSoundSpeed)";
@@ -1848,7 +1885,8 @@ void FluidSolver::checkClosedDomainBalance() {
 
 StepResult FluidSolver::solve() {
   ScopedRegion region("mfsi::fluid::solve");
-  if (closedDomain()) checkClosedDomainBalance();
+  if (closedDomain()) checkClosedDomainBalance(-1);
+  for (int r = 0; r < closedRegions_; ++r) checkClosedDomainBalance(r);
   StepResult res;
   const auto& pim = opt_.pimple;
   ConstRealView V = geo_.cellVolume;

@@ -161,7 +161,15 @@ class FluidSolver {
   /// \brief Volume flow into the domain through the prescribed-velocity and flow-rate faces at the
   /// end of the current step [m^3/s], summed over the ranks: what the moving walls of a domain
   /// closed to pressure must make room for.
-  real prescribedInflow() const;
+  real prescribedInflow() const { return prescribedInflow(-1); }
+  /// The same through the faces of the cells of closed region `region` (addClosedRegion; -1: all).
+  real prescribedInflow(int region) const;
+  /// \brief Cells that no pressure boundary reaches, beside cells that one does (a chamber walled
+  /// off by a membrane baffle): the pressure level there is pinned at `referenceCell` (a global id
+  /// in the region) as in a closed domain, and every solve checks that the region's boundary
+  /// fluxes balance. `localCells` flags this rank's cells of the region (one entry per local cell).
+  /// Returns the region's index.
+  int addClosedRegion(const std::vector<char>& localCells, long long referenceCell);
   /// True when no boundary face prescribes the pressure and the fluid is incompressible: the
   /// domain is closed, and a reference cell fixes the pressure level.
   bool closedDomain() const { return pinsPressureLevel(); }
@@ -221,8 +229,11 @@ class FluidSolver {
   PressureRow pressureRow(bool stored) const;
   void assemblePressureMatrixFaces();
   void pinPressureLevel();
-  /// A closed domain: throws DivergenceError when the boundary fluxes do not sum to zero.
-  void checkClosedDomainBalance();
+  /// A closed domain (region -1) or closed region: throws DivergenceError when the boundary fluxes
+  /// do not sum to zero.
+  void checkClosedDomainBalance(int region);
+  /// The pinned rows' diagonals doubled (the whole domain's reference cell, the closed regions').
+  bool pinsAnyLevel() const { return pinsPressureLevel() || regionPinRows_.extent(0) > 0; }
   bool fusedPressureSource() const;
   /// The fused per-cell pressure-matrix and end-of-step passes apply (Gather reduction).
   bool fusedCellPasses() const;
@@ -262,6 +273,11 @@ class FluidSolver {
   /// Local row of the pressure reference cell (pressureReferenceCell, a global id), -1 when another
   /// rank owns it.
   lid_t referenceRow_ = -1;
+  /// Closed regions beside open ones (addClosedRegion): each local cell's region (-1: none), their
+  /// number, and the reference rows on this rank.
+  IndexView cellClosedRegion_;
+  int closedRegions_ = 0;
+  IndexView regionPinRows_;
 
   MeshGeometry geo_;
   FvFaceData fd_;

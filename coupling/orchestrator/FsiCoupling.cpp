@@ -133,53 +133,83 @@ FsiCoupling::FsiCoupling(const CouplingOptions& options, const SceneConfig& sect
 }
 
 void FsiCoupling::setUpChamber(const SceneConfig& section) {
-  if (!options_.volumeConstraint) return;
-  const fluid::FluidSolver& f = fluid_->solver();
+  fluid::FluidSolver& f = fluid_->solver();
+  // Artificial compressibility: the fluid takes a volume change itself.
+  if (f.options().artificialCompressibility.soundSpeed > 0) return;
   std::vector<std::string> pressure;
   for (const auto& [name, bc] : f.options().boundaries)
     if (bc.type == fluid::BoundaryType::FixedPressure || bc.type == fluid::BoundaryType::Resistance)
       pressure.push_back(name);
   const coupling::ChamberRegions regions = coupling::findChamberRegions(whole_, pressure);
-  const bool anyClosed = std::find(regions.closed.begin(), regions.closed.end(), 1) != regions.closed.end();
-  if (!anyClosed) return;
-  // A region of incompressible fluid walled in beside an open one would need a pressure level of
-  // its own in the fluid; several closed regions, one each. Neither is built yet.
-  const auto where = section.where("volumeConstraint");
-  if (!f.closedDomain()) {
-    if (pressure.empty()) return;  // artificial compressibility: the fluid takes the volume change itself
-    throw InputError(where, "a closed region of fluid (no pressure boundary) lies beside an open one: not supported "
-                            "yet (its pressure level would be undefined); give it a pressure boundary, artificial "
-                            "compressibility (fluid.artificialSoundSpeed), or set coupling.volumeConstraint: false");
+  const long long nClosed = std::count(regions.closed.begin(), regions.closed.end(), char(1));
+  if (nClosed == 0) return;
+  // A closed region beside open ones: the fluid pins its pressure level and checks its balance.
+  auto registerRegion = [&](int r) {
+    auto gid = Kokkos::create_mirror_view_and_copy(HostSpace(), mesh_.cellGlobalIds());
+    std::vector<char> local(static_cast<std::size_t>(mesh_.nCells()));
+    for (lid_t c = 0; c < mesh_.nCells(); ++c) local[c] = regions.cellRegion[static_cast<std::size_t>(gid(c))] == r;
+    lid_t reference = 0;
+    while (regions.cellRegion[reference] != r) ++reference;
+    return f.addClosedRegion(local, reference);
+  };
+  if (!options_.volumeConstraint) {
+    // Plain Dirichlet-Neumann coupling: an iterate whose volume misses the inflow then stops the
+    // run with that reason (instead of a singular pressure equation).
+    if (!f.closedDomain())
+      for (int r = 0; r < regions.count; ++r)
+        if (regions.closed[r]) registerRegion(r);
+    return;
   }
-  if (regions.count > 1)
-    throw InputError(where, "the fluid mesh falls into " + std::to_string(regions.count) +
-                                " closed regions (a membrane baffle across it?): a volume constraint per region is "
-                                "not supported yet; set coupling.volumeConstraint: false or use artificial "
+  const auto where = section.where("volumeConstraint");
+  if (nClosed > 1)
+    throw InputError(where, "the fluid mesh has " + std::to_string(nClosed) +
+                                " regions no pressure boundary reaches: one volume constraint per region is not "
+                                "supported yet; set coupling.volumeConstraint: false or use artificial "
                                 "compressibility (fluid.artificialSoundSpeed)");
-  // The membrane patches close the domain (a baffle inside it has fluid on both sides and sweeps
-  // no net volume).
+  const int region = static_cast<int>(std::find(regions.closed.begin(), regions.closed.end(), char(1)) -
+                                      regions.closed.begin());
+  // The membrane sides that bound the region: a patch's fluid side, a baffle's master side (the
+  // region grows along the membrane normal) or slave side (it shrinks). A baffle with fluid of the
+  // region on both sides sweeps no net volume of it.
+  auto own = Kokkos::create_mirror_view_and_copy(HostSpace(), whole_.faceOwner());
+  auto sideIn = [&](const std::vector<lid_t>& faces) {
+    int inside = 0;
+    for (lid_t face : faces) inside += regions.cellRegion[own(face)] == region ? 1 : 0;
+    if (inside != 0 && inside != static_cast<int>(faces.size()))
+      throw InputError(where, "a membrane side lies partly in a closed fluid region: not supported");
+    return inside > 0;
+  };
+  double sign = 0;
   for (std::size_t i = 0; i < panels_.size(); ++i) {
     const Panel& p = panels_[i];
-    if (p.iface.side != coupling::InterfaceSide::Patch) continue;
+    const FluidSurfaceMembraneInput& surf = *p.module->fluidSurface();
+    const bool front = sideIn(surf.masterFace), back = !surf.slaveFace.empty() && sideIn(surf.slaveFace);
+    if (front == back) continue;
     if (chamber_.panel >= 0)
-      throw InputError(where, "the closed fluid domain is bounded by two membranes (" +
+      throw InputError(where, "a closed fluid region is bounded by two membranes (" +
                                   panels_[chamber_.panel].module->name() + " and " + p.module->name() +
                                   "): one volume constraint shared by several membranes is not supported yet");
     if (!p.dynamic)
-      throw InputError(where, p.module->name() + " closes the fluid domain: its volume constraint needs the dynamic "
+      throw InputError(where, p.module->name() + " closes a fluid region: its volume constraint needs the dynamic "
                               "analysis (membranes.N.analysis: dynamic)");
     if (p.mounted)
-      throw InputError(where, p.module->name() + " closes the fluid domain on moving bodies: a volume constraint "
+      throw InputError(where, p.module->name() + " closes a fluid region on moving bodies: a volume constraint "
                               "for a mounted membrane is not supported yet");
     chamber_.panel = static_cast<int>(i);
+    sign = front ? 1.0 : -1.0;
   }
-  if (chamber_.panel < 0) return;
+  if (chamber_.panel < 0) {
+    if (f.closedDomain()) return;  // no membrane closes it: the fluid checks that its fluxes balance
+    throw InputError(where, "a region of the fluid no pressure boundary reaches is closed by no membrane: its pressure "
+                            "level is undefined; give it a pressure boundary or artificial compressibility");
+  }
+  if (!f.closedDomain()) chamber_.fluidRegion = registerRegion(region);
   MembraneSolver& s = panels_[chamber_.panel].module->solver();
-  // The membrane's element normals are the fluid faces' outward area vectors
-  // (coupling/interface/MembraneInterface): the domain grows along them.
+  // The membrane's element normals are the fluid faces' area vectors (the master side's on a
+  // baffle; coupling/interface/MembraneInterface).
   MembraneVolumeConstraint& vc = s.volumeConstraint();
   vc.active = true;
-  vc.sign = 1;
+  vc.sign = sign;
   vc.lambda = 0;
   chamber_.volumeStart = s.enclosedVolume(s.displacement());
   vc.target = chamber_.volumeStart;
@@ -191,7 +221,7 @@ void FsiCoupling::beginChamberStep() {
   // equals the prescribed inflow Q at t_n+1.
   const fluid::FluidSolver& f = fluid_->solver();
   const fluid::FluidSolver::MeshFluxWeights w = f.meshFluxWeights();
-  const double q = f.prescribedInflow();
+  const double q = f.prescribedInflow(chamber_.fluidRegion);
   last_.volumeStep = (w.dt * q + w.c00 * chamber_.sweptLast) / w.c1;
   panels_[chamber_.panel].module->solver().volumeConstraint().target = chamber_.volumeStart + last_.volumeStep;
 }

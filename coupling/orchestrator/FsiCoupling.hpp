@@ -200,6 +200,7 @@ class FsiCoupling final : public Module {
   /// The membrane that closes a closed fluid domain, and the volume bookkeeping of its constraint.
   struct Chamber {
     int panel = -1;            ///< index into panels_; -1: no constraint
+    int fluidRegion = -1;      ///< the fluid's closed region (FluidSolver::addClosedRegion); -1: the whole domain
     double volumeStart = 0;    ///< the chamber's volume change where the fluid mesh is at the step's start
     double sweptLast = 0;      ///< what the membrane swept in the last step (the BDF2 mesh flux reads it)
     double maxMissRun = 0;     ///< largest volume miss of the run [m^3]
