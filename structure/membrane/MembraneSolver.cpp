@@ -625,6 +625,7 @@ void MembraneSolver::commitStep() {
   Kokkos::deep_copy(exec_, a_, a1_);
   time_ += trial_.dt;
   trial_ = {};
+  lambdaCommitted_ = volume_.lambda;
   exec_.fence();
 }
 
@@ -689,7 +690,11 @@ MembraneSolveReport MembraneSolver::solveStep(real dt) {
     Kokkos::deep_copy(exec_, Kdamp_.values, K_.values);
   }
   // Residual at t_n (needed by generalized-alpha) and, the first time, a_n from M a = R - C v.
+  // (with the multiplier of t_n: the iterate's own, a warm start, enters only R_{n+1})
+  const real lambdaIterate = volume_.lambda;
+  volume_.lambda = lambdaCommitted_;
   evalResidual(u_, time_, 1);
+  volume_.lambda = lambdaIterate;
   Kokkos::deep_copy(exec_, rn_, R_);
   MembraneSolveReport rep;
   if (!haveAcceleration_) {
@@ -827,7 +832,10 @@ void MembraneSolver::saveState(io::StateWriter& w) const {
   report.putInt("lineSearchSteps", last_.lineSearchSteps);
   report.putReal("relativeResidual", last_.relativeResidual);
   report.putReal("seconds", last_.seconds);
-  if (volume_.active) w.putReal("volumeMultiplier", volume_.lambda);
+  if (volume_.active) {
+    w.putReal("volumeMultiplier", volume_.lambda);
+    w.putReal("volumeMultiplierCommitted", lambdaCommitted_);
+  }
   io::StateWriter loads = w.sub("loads");
   if (loads_.nodePressure.extent(0) > 0) loads.putView("nodePressure", loads_.nodePressure);
   if (loads_.elementPressure.extent(0) > 0) loads.putView("elementPressure", loads_.elementPressure);
@@ -848,7 +856,10 @@ void MembraneSolver::loadState(const io::StateReader& r) {
   last_.lineSearchSteps = static_cast<int>(report.integer("lineSearchSteps"));
   last_.relativeResidual = report.real("relativeResidual");
   last_.seconds = report.real("seconds");
-  if (volume_.active && r.has("volumeMultiplier")) volume_.lambda = r.real("volumeMultiplier");
+  if (volume_.active && r.has("volumeMultiplier")) {
+    volume_.lambda = r.real("volumeMultiplier");
+    lambdaCommitted_ = r.real("volumeMultiplierCommitted");
+  }
   const io::StateReader loads = r.sub("loads");
   if (loads.has("nodePressure")) {
     if (loads_.nodePressure.extent(0) == 0)

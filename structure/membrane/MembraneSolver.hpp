@@ -231,6 +231,7 @@ class MembraneSolver {
   RealView u_, v_, a_, R_, Fext_, du_, uTrial_, work_, work2_, rn_, lumpedMass_, pNode_, offsetSign_;
   RealView a1_, v1_, rhs_, dampingForce_;  ///< time-step work vectors
   MembraneVolumeConstraint volume_;
+  real lambdaCommitted_ = 0;  ///< the multiplier at time(): generalized-alpha's R_n carries it
   RealView volumeGrad_, volumeDu_;  ///< g and b of the constrained Newton step
   RealView pElem_, pElemScaled_;  ///< element pressure in use (the load field, or a scaled copy)
   // Clamps: node ids, reference-frame targets at the requested time, start values of a load ramp.

@@ -129,3 +129,27 @@ TEST(MembraneVolume, ProjectionMeetsTheTargetAndKeepsConstrainedDirections) {
   EXPECT_GT(size, 1e-3);
   EXPECT_LT(off, 1e-14 * size) << "the projection moved a node off its constrained direction";
 }
+
+TEST(MembraneVolume, GeneralizedAlphaMultiplierIsTheStepsNotTheStartGuess) {
+  // Generalized-alpha weighs the loads of t_n by alpha_f: the multiplier of t_n must enter there,
+  // never the iterate's starting guess, or the step's answer depends on where Newton started.
+  Sphere s = sphere(8);
+  s.opt.material.density = 1;  // inertia matters: the step is dynamic
+  s.opt.dynamics.integrator = MembraneTimeIntegrator::GeneralizedAlpha;
+  s.opt.dynamics.rhoInfinity = 0.5;
+  std::vector<double> lambdas;
+  for (double guess : {0.0, 1000.0}) {
+    MembraneSolver solver(s.mesh, s.opt, s.bc);
+    MembraneVolumeConstraint& vc = solver.volumeConstraint();
+    vc.active = true;
+    vc.target = solver.enclosedVolume(scaledPositions(s.mesh, 1.1));
+    ASSERT_TRUE(solver.step(0.01).converged);
+    vc.target = solver.enclosedVolume(scaledPositions(s.mesh, 1.2));
+    vc.lambda = guess;
+    const MembraneSolveReport rep = solver.solveStep(0.01);
+    ASSERT_TRUE(rep.converged) << "guess " << guess;
+    lambdas.push_back(vc.lambda);
+  }
+  std::printf("second step's multiplier from the guesses 0 and 1000 Pa: %.15g, %.15g\n", lambdas[0], lambdas[1]);
+  EXPECT_NEAR(lambdas[0], lambdas[1], 1e-9 * std::abs(lambdas[0]));
+}
