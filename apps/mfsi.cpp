@@ -287,7 +287,10 @@ int commandRun(std::string sceneArg, const std::vector<std::string>& sets, std::
   } catch (const mfsi::DivergenceError& e) {
     summary.status = "diverged";
     summary.error = e.what();
-    report(std::string("diverged: ") + e.what());
+    // The last good state, when the run saved one (checkpoints are written after complete steps).
+    if (sim && !sim->lastCheckpoint().empty())
+      summary.error += "; last good checkpoint: " + sim->lastCheckpoint() + " (mfsi run --restart it with other settings)";
+    report("diverged: " + summary.error);
     code = 3;
   } catch (const mfsi::OutputError& e) {
     summary.status = "error";

@@ -296,6 +296,7 @@ RunResult Simulation::run(const std::string& outDir, bool terminal, bool continu
   auto checkpoint = [&] {
     ScopedTimer t(timers_, "checkpoint");
     r.lastCheckpoint = writeCheckpoint(outDir, ts, fields, nextFrameTime, lastFrameStep, wallSeconds() - start);
+    lastCheckpoint_ = r.lastCheckpoint;
     lastCheckpointWall = wallSeconds();
     lastCheckpointStep = ts.step;
   };

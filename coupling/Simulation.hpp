@@ -94,6 +94,8 @@ class Simulation {
   /// diverged run reports how far it got).
   long long completedSteps() const { return completedSteps_; }
   double completedTime() const { return completedTime_; }
+  /// Path of the last checkpoint this run wrote ("" if none): where a diverged run can go back to.
+  const std::string& lastCheckpoint() const { return lastCheckpoint_; }
 
  private:
   void meshMetrics(std::map<std::string, double>& m) const;
@@ -144,6 +146,7 @@ class Simulation {
   std::vector<Module*> reporting_;                ///< modules_ and their parts: output, columns, metrics
   long long completedSteps_ = 0;
   double completedTime_ = 0;
+  std::string lastCheckpoint_;
 };
 
 }  // namespace mfsi
