@@ -586,6 +586,10 @@ void FluidSolver::saveState(io::StateWriter& w) const {
   w.putView("pressureMatrix", Ap_.values);
   w.put("time", std::vector<double>{t_, dt_, dt0_, c1_, c0_, c00_});
   w.putInt("steps", nSteps_);
+  // The levels a closed domain and closed regions are pinned at (a coupling moves them).
+  std::vector<double> levels{opt_.pressureReferenceValue};
+  levels.insert(levels.end(), regionLevel_.begin(), regionLevel_.end());
+  w.put("pressureLevels", levels);
   w.putInt("pressureAssemblies", pressureAssemblies_);
   w.putInt("refreshBaselineIterations", refreshBaselineIterations_);
   const bool flags[] = {pressureRefreshDue_, bdf2Active_, gradPValid_, sweptNewZero_, sweptOldZero_, meshStatic_,
@@ -602,6 +606,12 @@ void FluidSolver::saveState(io::StateWriter& w) const {
 void FluidSolver::loadState(const io::StateReader& r) {
   // The geometry of the points the mesh is at now (restored by the caller), as moveMesh made it.
   updateGeometry();
+  if (r.has("pressureLevels")) {
+    const auto levels = r.doubles("pressureLevels", 1 + static_cast<long long>(regionLevel_.size()));
+    opt_.pressureReferenceValue = levels[0];
+    for (std::size_t k = 0; k < regionLevel_.size(); ++k) regionLevel_[k] = levels[k + 1];
+    if (!regionLevel_.empty()) shiftPressureLevel(0, 0);  // the pinned values
+  }
   r.getView("U", U_);
   r.getView("U0", U0_);
   r.getView("U00", U00_);
@@ -1575,17 +1585,21 @@ void FluidSolver::finishPressureSource() {
         "mfsi::fluid::pressure::compressibilitySource", RangePolicy(exec_, 0, nRows_),
         KOKKOS_LAMBDA(lid_t c) { rhs(c) += k * (c0 * V0(c) * p0(c) - c00 * V00(c) * p00(c)); });
   }
-  if (pinsPressureLevel() && referenceRow_ >= 0) {
-    // The reference row's diagonal was doubled from a: its source gets a pRef (a = half of it).
-    const lid_t ref = referenceRow_;
+  if (pinsAnyLevel()) {
+    // A reference row's diagonal was doubled from a: its source gets a times its level (a = half
+    // of it). The whole domain's row first, then the closed regions'.
+    const lid_t ref = pinsPressureLevel() ? referenceRow_ : -1;
     const real pRef = opt_.pressureReferenceValue;
-    ConstIndexView di = Ap_.diagIdx;
-    ConstRealView vals = Ap_.values;
+    ConstIndexView di = Ap_.diagIdx, rows = regionPinRows_;
+    ConstRealView vals = Ap_.values, levels = regionPinValues_;
     ConstRealView d = pressureLattice_ != nullptr ? pressureLattice_->diagonal() : RealView();
     auto rhs = rhsP_;
     Kokkos::parallel_for(
-        "mfsi::fluid::pressure::referenceSource", RangePolicy(exec_, 0, 1), KOKKOS_LAMBDA(lid_t) {
-          rhs(ref) += 0.5 * (d.extent(0) > 0 ? d(ref) : vals(di(ref))) * pRef;
+        "mfsi::fluid::pressure::referenceSource", RangePolicy(exec_, 0, static_cast<lid_t>(rows.extent(0)) + 1),
+        KOKKOS_LAMBDA(lid_t i) {
+          const lid_t r = i == 0 ? ref : rows(i - 1);
+          if (r < 0) return;
+          rhs(r) += 0.5 * (d.extent(0) > 0 ? d(r) : vals(di(r))) * (i == 0 ? pRef : levels(i - 1));
         });
   }
 }
@@ -1640,15 +1654,50 @@ int FluidSolver::addClosedRegion(const std::vector<char>& localCells, long long 
     h(c) = region;
     if (c < nRows_ && static_cast<long long>(gid(c)) == referenceCell) {
       rows.push_back(c);
+      regionPinRegion_.push_back(region);
       found = 1;
     }
   }
+  regionLevel_.push_back(0);
   MFSI_CHECK(comm_.globalSum(static_cast<double>(found)) == 1.0,
              "fluid: the reference cell " << referenceCell << " of a closed region is not one of its cells");
   Kokkos::deep_copy(cellClosedRegion_, h);
   regionPinRows_ = IndexView("mfsi::fluid::regionPinRows", rows.size());
   Kokkos::deep_copy(regionPinRows_, Kokkos::View<lid_t*, HostSpace>(rows.data(), rows.size()));
+  shiftPressureLevel(region, 0);  // the pinned values
   return region;
+}
+
+real FluidSolver::pressureLevel(int region) const {
+  return region < 0 ? opt_.pressureReferenceValue : regionLevel_.at(static_cast<std::size_t>(region));
+}
+
+void FluidSolver::shiftPressureLevel(int region, real delta) {
+  MFSI_CHECK(region < closedRegions_, "fluid: no closed region " << region);
+  if (region < 0)
+    opt_.pressureReferenceValue += delta;
+  else
+    regionLevel_[static_cast<std::size_t>(region)] += delta;
+  std::vector<real> values(regionPinRegion_.size());
+  for (std::size_t i = 0; i < values.size(); ++i) values[i] = regionLevel_[static_cast<std::size_t>(regionPinRegion_[i])];
+  if (regionPinValues_.extent(0) != values.size())
+    regionPinValues_ = RealView("mfsi::fluid::regionPinValues", values.size());
+  Kokkos::deep_copy(regionPinValues_, Kokkos::View<real*, HostSpace>(values.data(), values.size()));
+  if (delta == 0) return;
+  ConstIndexView cr = cellClosedRegion_, own = mesh_.faceOwner();
+  auto p = p_, pp = pPrev_, pb = pb_;
+  const lid_t nIn = nIn_;
+  Kokkos::parallel_for(
+      "mfsi::fluid::pressure::shiftLevel", RangePolicy(exec_, 0, nCells_), KOKKOS_LAMBDA(lid_t c) {
+        if (region >= 0 && cr(c) != region) return;
+        p(c) += delta;
+        pp(c) += delta;
+      });
+  Kokkos::parallel_for(
+      "mfsi::fluid::pressure::shiftLevelBoundary", RangePolicy(exec_, 0, nB_), KOKKOS_LAMBDA(lid_t b) {
+        if (region >= 0 && cr(own(b + nIn)) != region) return;
+        pb(b) += delta;
+      });
 }
 
 real FluidSolver::prescribedInflow(int region) const {

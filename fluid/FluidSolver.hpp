@@ -170,6 +170,12 @@ class FluidSolver {
   /// fluxes balance. `localCells` flags this rank's cells of the region (one entry per local cell).
   /// Returns the region's index.
   int addClosedRegion(const std::vector<char>& localCells, long long referenceCell);
+  /// \brief Raise the pressure of a closed domain (region -1) or closed region by `delta`: its
+  /// cells, boundary faces and the level its reference cell is pinned at. Nothing else changes
+  /// (the level is free there); a coupling ties it to the multiplier of a volume constraint.
+  void shiftPressureLevel(int region, real delta);
+  /// The level a closed domain (-1) or region is pinned at [Pa].
+  real pressureLevel(int region) const;
   /// True when no boundary face prescribes the pressure and the fluid is incompressible: the
   /// domain is closed, and a reference cell fixes the pressure level.
   bool closedDomain() const { return pinsPressureLevel(); }
@@ -278,6 +284,9 @@ class FluidSolver {
   IndexView cellClosedRegion_;
   int closedRegions_ = 0;
   IndexView regionPinRows_;
+  RealView regionPinValues_;            ///< per pinned row: its region's level
+  std::vector<int> regionPinRegion_;    ///< per pinned row: its region
+  std::vector<real> regionLevel_;       ///< per closed region: the level it is pinned at
 
   MeshGeometry geo_;
   FvFaceData fd_;

@@ -733,6 +733,17 @@ void FsiCoupling::advance(const TimeState& t) {
     chamber_.maxMissRun = std::max(chamber_.maxMissRun, last_.volumeMiss);
   }
   commitStructure();
+  if (chamber_.panel >= 0) {
+    // The fluid's pressure level in the chamber takes over the multiplier: its field is then the
+    // physical pressure, and the next step's multiplier is the change of the level over it.
+    Panel& p = panels_[chamber_.panel];
+    MembraneSolver& s = p.module->solver();
+    const real lambda = s.volumeConstraint().lambda, shift = s.volumeConstraint().sign * lambda;
+    fluid_->solver().shiftPressureLevel(chamber_.fluidRegion, lambda);
+    s.shiftMultiplier(-lambda);
+    for (const RealView& v : {p.load, p.loadPrevious, p.filtered})
+      if (v.extent(0) > 0) blas::shift(exec_, static_cast<lid_t>(v.extent(0)), shift, v);
+  }
   advanceLoadFilter();
   fluid_->endStep();
   for (Panel& p : panels_) p.module->sampleState();

@@ -29,7 +29,9 @@
 /// step the target is the volume the fluid's mesh flux needs, c1 dV = dt Q + c00 dV_last (BDF2
 /// weights), and the membrane solves with a volume constraint (MembraneVolumeConstraint: a uniform
 /// pressure as multiplier); every relaxed iterate is moved back onto the constraint before the
-/// fluid sees it, so the pressure equation is consistent in every coupling iteration.
+/// fluid sees it, so the pressure equation is consistent in every coupling iteration. After the
+/// step the fluid's pressure level in the chamber takes over the multiplier
+/// (FluidSolver::shiftPressureLevel), so the fluid's field is the physical pressure.
 ///
 /// Membrane state never leaks from one iteration into the next: a dynamic membrane re-solves the
 /// step from its committed state (MembraneSolver::solveStep) and commits once; the fluid re-solves

@@ -113,6 +113,12 @@ class MembraneSolver {
   /// constraint's tolerance (a relaxed FSI iterate the fluid must be able to follow). Returns the
   /// largest nodal move.
   real projectOntoVolume(const RealView& u);
+  /// \brief Add `delta` to the multiplier, of the committed state too: another module took over
+  /// -delta of the uniform pressure (a fluid whose pressure level was raised by it).
+  void shiftMultiplier(real delta) {
+    volume_.lambda += delta;
+    lambdaCommitted_ += delta;
+  }
 
   real time() const { return time_; }
   void setTime(real t) { time_ = t; }
