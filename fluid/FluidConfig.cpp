@@ -63,7 +63,14 @@ Schema boundarySchema() {
                .key("period", Schema::real("period or ramp time", "s").greaterThan(0), Default(1.0))
                .key("pulseDuration", Schema::real("halfPowerSine: pulse length (0: period / 2)", "s").atLeast(0),
                     Default(0.0))
-               .key("exponent", Schema::real("halfPowerSine: exponent", "-").greaterThan(0), Default(0.5)),
+               .key("exponent", Schema::real("halfPowerSine: exponent", "-").greaterThan(0), Default(0.5))
+               .key("secondAmplitude",
+                    Schema::real("halfPowerSine: a second pulse right after the first, this times the boundary value "
+                                 "(negative: the other way; 0: none)",
+                                 "-"),
+                    Default(0.0))
+               .key("secondDuration", Schema::real("halfPowerSine: the second pulse's length", "s").atLeast(0),
+                    Default(0.0)),
            Presence::Optional);
 }
 
@@ -144,8 +151,19 @@ PatchBC readBoundary(const SceneConfig& b) {
     bc.timeFunction.period = b.get<double>("timeFunction.period");
     bc.timeFunction.pulseDuration = b.get<double>("timeFunction.pulseDuration");
     bc.timeFunction.exponent = b.get<double>("timeFunction.exponent");
+    bc.timeFunction.secondAmplitude = b.get<double>("timeFunction.secondAmplitude");
+    bc.timeFunction.secondDuration = b.get<double>("timeFunction.secondDuration");
     if (bc.timeFunction.pulseDuration > bc.timeFunction.period)
       throw InputError(b.where("timeFunction.pulseDuration"), "must not exceed the period");
+    const double first =
+        bc.timeFunction.pulseDuration > 0 ? bc.timeFunction.pulseDuration : 0.5 * bc.timeFunction.period;
+    if (bc.timeFunction.secondAmplitude != 0 && !(bc.timeFunction.secondDuration > 0))
+      throw InputError(b.where("timeFunction.secondDuration"), "a second pulse (secondAmplitude) needs a duration > 0");
+    if (bc.timeFunction.secondAmplitude != 0 && first + bc.timeFunction.secondDuration > bc.timeFunction.period * (1 + 1e-12))
+      throw InputError(b.where("timeFunction.secondDuration"),
+                       "the two pulses (" + std::to_string(first) + " + " +
+                           std::to_string(bc.timeFunction.secondDuration) + " s) must fit in the period (" +
+                           std::to_string(bc.timeFunction.period) + " s)");
   }
   return bc;
 }

@@ -20,9 +20,12 @@ real TimeFunction::operator()(real t) const {
       const real tp = pulseDuration > 0 ? pulseDuration : 0.5 * period;
       real tau = std::fmod(t, period);
       if (tau < 0) tau += period;
-      if (tau >= tp) return 0.0;
-      // max(): sin may round to a tiny negative value at tau ~ tp, which a fractional power turns into NaN.
-      return std::pow(std::max(std::sin(pi * tau / tp), real(0)), exponent);
+      // max(): sin may round to a tiny negative value at the end of a pulse, which a fractional
+      // power turns into NaN.
+      if (tau < tp) return std::pow(std::max(std::sin(pi * tau / tp), real(0)), exponent);
+      if (secondAmplitude != 0 && tau < tp + secondDuration)
+        return secondAmplitude * std::pow(std::max(std::sin(pi * (tau - tp) / secondDuration), real(0)), exponent);
+      return 0.0;
     }
   }
   return 1.0;

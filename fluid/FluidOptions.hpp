@@ -74,8 +74,9 @@ struct TimeFunction {
     CosineRamp,   ///< f = (1 - cos(pi t / period)) / 2 for t < period, then 1
     Function,     ///< f = fn(t)
     /// Half-power sine pulse (ventricular-assist-device inflow): with tau = t mod period,
-    /// f = sin(pi tau / pulseDuration)^exponent for tau < pulseDuration, else 0. The amplitude A is
-    /// the boundary value the function multiplies (velocity, flow rate or pressure).
+    /// f = sin(pi tau / pulseDuration)^exponent for tau < pulseDuration, else 0 (or a second
+    /// pulse, secondAmplitude). The amplitude A is the boundary value the function multiplies
+    /// (velocity, flow rate or pressure).
     HalfPowerSine,
   };
   Kind kind = Kind::Constant;
@@ -85,6 +86,11 @@ struct TimeFunction {
   real pulseDuration = 0.0;
   /// HalfPowerSine: exponent p of the sine (> 0); 0.5 gives the "half-power" sine.
   real exponent = 0.5;
+  /// HalfPowerSine: a second pulse right after the first, for Tp <= tau < Tp + secondDuration:
+  /// f = secondAmplitude sin(pi (tau - Tp) / secondDuration)^exponent (a pump's ejection then
+  /// filling: secondAmplitude < 0). 0: none.
+  real secondAmplitude = 0.0;
+  real secondDuration = 0.0;
 
   /// \brief Value at time t.
   real operator()(real t) const;

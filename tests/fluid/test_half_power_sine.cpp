@@ -45,6 +45,32 @@ TEST(HalfPowerSine, Values) {
   EXPECT_EQ(f(1.1), 0.0);
 }
 
+TEST(HalfPowerSine, SecondPulse) {
+  // The pulsatile pump's air port (seed paper): ejection q_e sin^(1/2)(pi t / 0.3) for 0.3 s, then
+  // filling q_f sin^(1/2)(pi (t - 0.3) / 0.45), q_f / q_e = -212.68 / 319.02, at 80 beats per minute.
+  TimeFunction f;
+  f.kind = TimeFunction::Kind::HalfPowerSine;
+  f.period = 0.75;
+  f.pulseDuration = 0.3;
+  f.secondAmplitude = -212.68 / 319.02;
+  f.secondDuration = 0.45;
+  EXPECT_TRUE(near(f(0.15), 1.0, Tol{1e-15, 0}, "first peak"));
+  EXPECT_TRUE(near(f(0.3 + 0.225), -212.68 / 319.02, Tol{1e-15, 1e-14}, "second peak"));
+  EXPECT_TRUE(near(f(0.3 + 0.1125), -212.68 / 319.02 * std::sqrt(std::sqrt(0.5)), Tol{1e-15, 1e-14}, "second pulse"));
+  EXPECT_TRUE(near(f(0.75 + 0.15), 1.0, Tol{1e-14, 0}, "next beat"));
+  // Stroke volumes: int_0^Tp sin^(1/2) = Tp * 0.76275976 (Gamma(3/4) / (sqrt(pi) Gamma(5/4))), so
+  // 319.02 * 0.3 * 0.7628 = 73.0 mL out and 212.68 * 0.45 * 0.7628 = 73.0 mL back: the air chamber
+  // returns to its volume every beat.
+  double out = 0, back = 0;
+  const int n = 300000;
+  for (int i = 0; i < n; ++i) {
+    const double t = (i + 0.5) * 0.75 / n, v = 319.02 * f(t) * 0.75 / n;
+    (v > 0 ? out : back) += v;
+  }
+  EXPECT_TRUE(near(out, 73.0, Tol{0, 2e-3}, "ejected volume (mL)"));
+  EXPECT_TRUE(near(-back, out, Tol{0, 1e-4}, "filled volume = ejected volume"));
+}
+
 TEST(HalfPowerSine, InvalidParametersAreInputErrors) {
   HexMesh mesh = duct();
   FluidOptions o;
