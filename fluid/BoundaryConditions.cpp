@@ -164,10 +164,12 @@ BoundaryConditions::BoundaryConditions(const HexMesh& mesh, const FluidOptions& 
   external_ = Real3View("mfsi::fluid::bc::externalWallVelocity", nB);
   hVelocity_ = Kokkos::create_mirror_view(velocity_);
   hPressure_ = Kokkos::create_mirror_view(pressure_);
-  auto hKind = Kokkos::create_mirror_view(kind_);
-  for (const auto& rp : patches_)
-    for (lid_t f = rp.start; f < rp.start + rp.size; ++f) hKind(f - nIn_) = faceKindOf(rp.type);
-  Kokkos::deep_copy(kind_, hKind);
+  hKind_ = Kokkos::create_mirror_view(kind_);
+  for (const auto& rp : patches_) {
+    for (lid_t f = rp.start; f < rp.start + rp.size; ++f) hKind_(f - nIn_) = faceKindOf(rp.type);
+    hasValves_ = hasValves_ || rp.bc.valve.period > 0;
+  }
+  Kokkos::deep_copy(kind_, hKind_);
 }
 
 std::vector<int> BoundaryConditions::find(const std::string& name) const {
@@ -190,8 +192,33 @@ void BoundaryConditions::update(const ExecSpace& exec, real t, const MeshGeometr
     Kokkos::deep_copy(hSf, geo.faceArea);
     Kokkos::deep_copy(hFc, geo.faceCentroid);
   }
+  if (hasValves_) {
+    // Valves: a closed one's faces are no-slip walls (no flow), an open one's the pressure condition.
+    bool changed = false, anyOpen = false, anyPressure = false;
+    for (auto& rp : patches_) {
+      if (rp.type != BoundaryType::FixedPressure && rp.type != BoundaryType::Resistance) continue;
+      anyPressure = true;
+      const bool open = rp.bc.valve.open(t);
+      anyOpen = anyOpen || open;
+      if (open == rp.open) continue;
+      changed = true;
+      rp.open = open;
+      if (!open) rp.currentFlowRate = 0;
+      for (lid_t f = rp.start; f < rp.start + rp.size; ++f) {
+        hKind_(f - nIn_) = open ? kFacePressure : kFaceWall;
+        for (int d = 0; d < 3; ++d) hVelocity_(f - nIn_, d) = 0;
+      }
+    }
+    // On a decomposed mesh a rank may hold no face of the pressure patches: the check is the
+    // options', not the faces'.
+    MFSI_CHECK(!anyPressure || anyOpen || !fixesPressure_,
+               "fluid: at t = " << t << " every pressure boundary's valve is closed: the pressure level is undefined "
+                                << "(give the valves overlapping open times, or a pressure boundary without a valve)");
+    if (changed) Kokkos::deep_copy(exec, kind_, hKind_);
+  }
   for (auto& rp : patches_) {
     const real ft = rp.bc.timeFunction(t);
+    if (!rp.open) continue;  // a closed valve: a fixed wall
     switch (rp.type) {
       case BoundaryType::FixedVelocity:
         for (lid_t f = rp.start; f < rp.start + rp.size; ++f) {
@@ -257,7 +284,7 @@ void BoundaryConditions::update(const ExecSpace& exec, real t, const MeshGeometr
 
 void BoundaryConditions::updateResistance(const ExecSpace& exec, const ConstRealView& phi) {
   for (auto& rp : patches_) {
-    if (rp.type != BoundaryType::Resistance) continue;
+    if (rp.type != BoundaryType::Resistance || !rp.open) continue;
     real q = 0;
     const lid_t start = rp.start;
     Kokkos::parallel_reduce(

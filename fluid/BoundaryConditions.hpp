@@ -33,6 +33,7 @@ struct ResolvedPatch {
   Vec3 boxMax{0, 0, 0};
   real currentPressure = 0;  ///< FixedPressure / Resistance: value last imposed
   real currentFlowRate = 0;  ///< outflow rate through the patch used for the resistance law
+  bool open = true;          ///< a valve's state at the last update (its faces walls when closed)
 };
 
 /// \brief Per-face boundary data of the fluid (labels `mfsi::fluid::bc::*`). Arrays are indexed by
@@ -63,6 +64,9 @@ class BoundaryConditions {
   ConstRealView pressure() const { return pressure_; }
   /// True when some face prescribes the pressure (otherwise a reference cell fixes its level).
   bool fixesPressureLevel() const { return fixesPressure_; }
+  /// True when a pressure patch has a valve: its faces switch between the pressure condition and
+  /// a wall (their kind changes with time).
+  bool hasValves() const { return hasValves_; }
   const std::vector<ResolvedPatch>& patches() const { return patches_; }
   /// Indices (into patches()) of the patches that `name` designates: a patch, or both baffle sides.
   std::vector<int> find(const std::string& name) const;
@@ -76,6 +80,8 @@ class BoundaryConditions {
   lid_t nIn_ = 0;
   real time_ = 0;
   bool fixesPressure_ = false;
+  bool hasValves_ = false;
+  IndexView::HostMirror hKind_;
   std::vector<ResolvedPatch> patches_;
   IndexView kind_;
   Real3View velocity_;

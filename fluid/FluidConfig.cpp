@@ -39,6 +39,13 @@ Schema boundarySchema() {
       .key("flowRate", Schema::real("flowRate: volumetric inflow, positive into the domain", "m^3/s"), Default(0.0))
       .key("pressure", Schema::real("fixedPressure: p; resistance: p0", "Pa"), Default(0.0))
       .key("resistance", Schema::real("resistance: C_r", "Pa s/m^3").atLeast(0), Default(0.0))
+      .key("valve",
+           Schema::map("fixedPressure/resistance: a valve, open (the pressure condition) while openFrom <= t mod "
+                       "period < openTo and a closed no-slip wall otherwise")
+               .key("period", Schema::real("the valve's cycle", "s").greaterThan(0))
+               .key("openFrom", Schema::real("opens at this time of the cycle", "s").atLeast(0), Default(0.0))
+               .key("openTo", Schema::real("closes at this time of the cycle", "s").greaterThan(0)),
+           Presence::OptionalSection)
       .key("profile",
            Schema::choice("fixedVelocity/flowRate: shape across the patch, s in [0, 1] across the extent along "
                           "each of parabolicAxes; parabolic = prod 4 s (1 - s); linear = prod s",
@@ -142,6 +149,17 @@ PatchBC readBoundary(const SceneConfig& b) {
     throw InputError(b.where("profile"), "a " + profile + " profile applies to fixedVelocity and flowRate patches only");
   bc.parabolicMin = vec3(b, "parabolicMin");
   bc.parabolicMax = vec3(b, "parabolicMax");
+  if (b.has("valve")) {
+    if (bc.type != BoundaryType::FixedPressure && bc.type != BoundaryType::Resistance)
+      throw InputError(b.where("valve"), "a valve applies to fixedPressure and resistance patches only");
+    bc.valve.period = b.get<double>("valve.period");
+    bc.valve.openFrom = b.get<double>("valve.openFrom");
+    bc.valve.openTo = b.get<double>("valve.openTo");
+    if (!(bc.valve.openFrom < bc.valve.openTo && bc.valve.openTo <= bc.valve.period))
+      throw InputError(b.where("valve"), "needs 0 <= openFrom < openTo <= period, got " +
+                                             std::to_string(bc.valve.openFrom) + ", " + std::to_string(bc.valve.openTo) +
+                                             ", " + std::to_string(bc.valve.period));
+  }
   if (b.has("timeFunction")) {
     const std::string tf = b.get<std::string>("timeFunction.type");
     bc.timeFunction.kind = tf == "oneMinusCos"     ? TimeFunction::Kind::OneMinusCos

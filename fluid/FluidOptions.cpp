@@ -31,6 +31,17 @@ real TimeFunction::operator()(real t) const {
   return 1.0;
 }
 
+bool PatchBC::Valve::open(real t) const {
+  if (!(period > 0)) return true;
+  real tau = std::fmod(t, period);
+  if (tau < 0) tau += period;
+  // A step that ends on a switching time (t = openTo, within round-off of the time sum) belongs
+  // to the phase that follows it.
+  const real eps = 1e-9 * period;
+  if (period - tau < eps) tau = 0;
+  return tau >= openFrom - eps && tau < openTo - eps;
+}
+
 const char* toString(TimeScheme s) {
   switch (s) {
     case TimeScheme::Steady:

@@ -118,6 +118,13 @@ struct PatchBC {
   real resistance = 0;        ///< Resistance: C_r [Pa s / m^3]
   TimeFunction timeFunction;  ///< multiplies the velocity, flow rate or pressure
   WallMotion wallMotion = WallMotion::Fixed;
+  /// \brief FixedPressure / Resistance: a valve. Open (the pressure condition) while
+  /// openFrom <= t mod period < openTo, closed (a no-slip wall, no flow) otherwise; period 0: always open.
+  struct Valve {
+    real period = 0, openFrom = 0, openTo = 0;
+    bool open(real t) const;
+  };
+  Valve valve;
 };
 
 /// \brief Preconditioner of the pressure equation's conjugate gradients.

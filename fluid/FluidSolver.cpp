@@ -368,7 +368,8 @@ FluidSolver::FluidSolver(const HexMesh& mesh, const FluidOptions& options, const
   bc_ = BoundaryConditions(mesh, opt_, comm_);
   boundaryCells_ = boundaryCells(mesh);
   for (const auto& rp : bc_.patches()) hasResistance_ = hasResistance_ || rp.type == BoundaryType::Resistance;
-  boundaryVelocityReadsU_ = countVelocityFromCells(exec_, bc_.kind(), nB_) > 0;
+  // A valve's faces read their cell's velocity while it is open.
+  boundaryVelocityReadsU_ = countVelocityFromCells(exec_, bc_.kind(), nB_) > 0 || bc_.hasValves();
   linear_ = LinearSolver(nCells_, opt_.pressurePreconditioner);
   if (cellHalo_) {
     AuRows_ = ownedRows(Au_, nRows_);
