@@ -159,6 +159,33 @@ HexMeshInput readGmsh(const std::string& path) {
     }
     out.patches[patchOfPhysical[q.physical]].faces.push_back(f);
   }
+  // Groups of internal faces are baffles.
+  std::map<std::array<lid_t, 4>, int> faceUses;
+  const int hexFace[6][4] = {{0, 3, 2, 1}, {4, 5, 6, 7}, {0, 1, 5, 4}, {1, 2, 6, 5}, {2, 3, 7, 6}, {3, 0, 4, 7}};
+  auto key = [](std::array<lid_t, 4> q) {
+    std::sort(q.begin(), q.end());
+    return q;
+  };
+  for (const auto& c : out.cells)
+    for (const auto& hf : hexFace) ++faceUses[key({c[hf[0]], c[hf[1]], c[hf[2]], c[hf[3]]})];
+  std::vector<HexMeshInput::PatchSpec> patches;
+  for (auto& p : out.patches) {
+    std::size_t internal = 0;
+    for (const auto& f : p.faces) {
+      const auto it = faceUses.find(key(f));
+      internal += it != faceUses.end() && it->second == 2 ? 1 : 0;
+    }
+    if (internal == 0) {
+      patches.push_back(std::move(p));
+    } else if (internal == p.faces.size()) {
+      out.baffles.push_back({p.name, std::move(p.faces)});
+    } else {
+      throw InputError(path + ": physical surface '" + p.name + "' has " + std::to_string(internal) +
+                       " internal faces and " + std::to_string(p.faces.size() - internal) +
+                       " boundary faces: a group is a boundary patch or a baffle, not both");
+    }
+  }
+  out.patches = std::move(patches);
   return out;
 }
 

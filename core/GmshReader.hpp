@@ -18,6 +18,10 @@ namespace mfsi {
 ///   physical tag, kind `PatchKind::Patch`. Surface elements of entities without a physical
 ///   group, and all 0D/1D elements, are ignored; boundary faces no patch claims end up in
 ///   `HexMeshInput::defaultPatch`.
+/// - Baffles: a physical group whose quadrangles are all internal faces (each shared by two
+///   hexahedra) is a baffle of that name instead (a membrane inside the flow); its quadrangles'
+///   node order sets the baffle normal, which points out of the master side. A group with both
+///   boundary and internal faces is an error.
 /// - Nodes: tags may be sparse and in any order; only nodes used by a hexahedron are kept,
 ///   renumbered 0..n-1 in file order.
 ///

@@ -161,6 +161,37 @@ TEST(GmshReader, BoxMatchesTheBlockGenerator) {
   }
 }
 
+// A physical surface of internal faces is a baffle: the pump's membrane between its two chambers.
+TEST(GmshReader, InternalFaceGroupIsABaffle) {
+  const auto in = mfsi::readGmsh(meshPath("vad_small.msh"));
+  ASSERT_EQ(in.baffles.size(), 1u);
+  EXPECT_EQ(in.baffles[0].name, "membrane");
+  EXPECT_EQ(in.baffles[0].faces.size(), 48u);
+  for (const auto& p : in.patches) EXPECT_NE(p.name, "membrane");
+  const auto mesh = mfsi::buildHexMesh(in);
+  const int master = mesh.findPatch("membrane_master"), slave = mesh.findPatch("membrane_slave");
+  ASSERT_GE(master, 0);
+  ASSERT_GE(slave, 0);
+  EXPECT_EQ(mesh.patches()[master].size, 48);
+  EXPECT_EQ(mesh.patches()[slave].size, 48);
+  EXPECT_EQ(mesh.nCells(), 144);
+  // The file's node order makes the normal +z: out of the blood (lower) side, the master side.
+  const mfsi::MeshGeometry geo = mfsi::allocateGeometry(mesh);
+  mfsi::computeGeometry(mfsi::ExecSpace(), mesh, geo);
+  auto sf = Kokkos::create_mirror_view_and_copy(mfsi::HostSpace(), geo.faceArea);
+  auto cc = Kokkos::create_mirror_view_and_copy(mfsi::HostSpace(), geo.cellCentroid);
+  auto fc = Kokkos::create_mirror_view_and_copy(mfsi::HostSpace(), geo.faceCentroid);
+  auto own = Kokkos::create_mirror_view_and_copy(mfsi::HostSpace(), mesh.faceOwner());
+  for (const int side : {master, slave}) {
+    const auto& m = mesh.patches()[side];
+    for (mfsi::lid_t f = m.start; f < m.start + m.size; ++f) {
+      // Master faces point up out of the blood cells below them; slave faces down out of the air cells.
+      EXPECT_GT(side == master ? sf(f, 2) : -sf(f, 2), 0) << "face " << f;
+      EXPECT_EQ(cc(own(f), 2) < fc(f, 2), side == master) << "face " << f;
+    }
+  }
+}
+
 // box.polyMesh: scrambled by the fixture script; openfoam_box: written by OpenFOAM's blockMesh.
 TEST(PolyMeshReader, BoxMatchesTheBlockGenerator) {
   const auto ref = referenceBox({0, 0, 0}, {1, 0.5, 0.25}, {4, 2, 2}, {1, 1, 1}, kNames);
