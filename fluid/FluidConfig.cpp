@@ -9,11 +9,53 @@ namespace mfsi {
 
 using namespace fluid;
 
+Schema timeFunctionSchema(const std::string& what) {
+  return Schema::map(what)
+      .key("type",
+           Schema::choice("constant: 1; oneMinusCos: 1 - cos(2 pi t / period); cosineRamp: (1 - cos(pi t "
+                          "/ period)) / 2 up to t = period, then 1; halfPowerSine: sin(pi tau / "
+                          "pulseDuration)^exponent for tau = t mod period < pulseDuration, else 0",
+                          {"constant", "oneMinusCos", "cosineRamp", "halfPowerSine"}),
+           Default("constant"))
+      .key("period", Schema::real("period or ramp time", "s").greaterThan(0), Default(1.0))
+      .key("pulseDuration", Schema::real("halfPowerSine: pulse length (0: period / 2)", "s").atLeast(0), Default(0.0))
+      .key("exponent", Schema::real("halfPowerSine: exponent", "-").greaterThan(0), Default(0.5))
+      .key("secondAmplitude",
+           Schema::real("halfPowerSine: a second pulse right after the first, this times the boundary value "
+                        "(negative: the other way; 0: none)",
+                        "-"),
+           Default(0.0))
+      .key("secondDuration", Schema::real("halfPowerSine: the second pulse's length", "s").atLeast(0), Default(0.0));
+}
+
+fluid::TimeFunction readTimeFunction(const SceneConfig& f) {
+  using fluid::TimeFunction;
+  TimeFunction tf;
+  const std::string type = f.get<std::string>("type");
+  tf.kind = type == "oneMinusCos"     ? TimeFunction::Kind::OneMinusCos
+            : type == "cosineRamp"    ? TimeFunction::Kind::CosineRamp
+            : type == "halfPowerSine" ? TimeFunction::Kind::HalfPowerSine
+                                      : TimeFunction::Kind::Constant;
+  tf.period = f.get<double>("period");
+  tf.pulseDuration = f.get<double>("pulseDuration");
+  tf.exponent = f.get<double>("exponent");
+  tf.secondAmplitude = f.get<double>("secondAmplitude");
+  tf.secondDuration = f.get<double>("secondDuration");
+  if (tf.pulseDuration > tf.period) throw InputError(f.where("pulseDuration"), "must not exceed the period");
+  const double first = tf.pulseDuration > 0 ? tf.pulseDuration : 0.5 * tf.period;
+  if (tf.secondAmplitude != 0 && !(tf.secondDuration > 0))
+    throw InputError(f.where("secondDuration"), "a second pulse (secondAmplitude) needs a duration > 0");
+  if (tf.secondAmplitude != 0 && first + tf.secondDuration > tf.period * (1 + 1e-12))
+    throw InputError(f.where("secondDuration"), "the two pulses (" + std::to_string(first) + " + " +
+                                                    std::to_string(tf.secondDuration) + " s) must fit in the period (" +
+                                                    std::to_string(tf.period) + " s)");
+  return tf;
+}
+
 namespace {
 
-const std::vector<std::string> kBoundaryTypes = {"fixedVelocity", "flowRate",      "wall",      "movingWall",
-                                                 "membraneWall",  "slip",          "empty",     "fixedPressure",
-                                                 "resistance"};
+const std::vector<std::string> kBoundaryTypes = {
+    "fixedVelocity", "flowRate", "wall", "movingWall", "membraneWall", "slip", "empty", "fixedPressure", "resistance"};
 
 Schema linearSolverSchema(const std::string& what, double tolerance, int maxIter) {
   return Schema::map(what +
@@ -29,7 +71,8 @@ Schema boundarySchema() {
       .key("type",
            Schema::choice("fixedVelocity: prescribed velocity; flowRate: volumetric inflow along the inward normal; "
                           "wall: no-slip, tangential velocity `velocity` (a driven lid); movingWall: no-slip moving "
-                          "with the mesh; membraneWall: no-slip moving with the coupled membrane on it; slip: free slip / symmetry; empty: front/back of a one-cell-thick 2D mesh; "
+                          "with the mesh; membraneWall: no-slip moving with the coupled membrane on it; slip: free "
+                          "slip / symmetry; empty: front/back of a one-cell-thick 2D mesh; "
                           "fixedPressure: p prescribed, zero-gradient velocity (outflow); resistance: p = resistance * "
                           "q + pressure, q the outflow rate",
                           kBoundaryTypes))
@@ -59,25 +102,7 @@ Schema boundarySchema() {
            Default(std::array<double, 3>{0, 0, 0}))
       .key("parabolicMax", Schema::realVector(3, "parabolic: upper end of the extent per axis", "m"),
            Default(std::array<double, 3>{0, 0, 0}))
-      .key("timeFunction",
-           Schema::map("factor f(t) on the velocity, flow rate or pressure")
-               .key("type",
-                    Schema::choice("constant: 1; oneMinusCos: 1 - cos(2 pi t / period); cosineRamp: (1 - cos(pi t "
-                                   "/ period)) / 2 up to t = period, then 1; halfPowerSine: sin(pi tau / "
-                                   "pulseDuration)^exponent for tau = t mod period < pulseDuration, else 0",
-                                   {"constant", "oneMinusCos", "cosineRamp", "halfPowerSine"}),
-                    Default("constant"))
-               .key("period", Schema::real("period or ramp time", "s").greaterThan(0), Default(1.0))
-               .key("pulseDuration", Schema::real("halfPowerSine: pulse length (0: period / 2)", "s").atLeast(0),
-                    Default(0.0))
-               .key("exponent", Schema::real("halfPowerSine: exponent", "-").greaterThan(0), Default(0.5))
-               .key("secondAmplitude",
-                    Schema::real("halfPowerSine: a second pulse right after the first, this times the boundary value "
-                                 "(negative: the other way; 0: none)",
-                                 "-"),
-                    Default(0.0))
-               .key("secondDuration", Schema::real("halfPowerSine: the second pulse's length", "s").atLeast(0),
-                    Default(0.0)),
+      .key("timeFunction", timeFunctionSchema("factor f(t) on the velocity, flow rate or pressure"),
            Presence::Optional);
 }
 
@@ -146,7 +171,8 @@ PatchBC readBoundary(const SceneConfig& b) {
   if (shaped && axes.empty())
     throw InputError(b.where("profile"), "a " + profile + " profile needs 'parabolicAxes' (e.g. [y])");
   if (shaped && bc.type != BoundaryType::FixedVelocity && bc.type != BoundaryType::FlowRate)
-    throw InputError(b.where("profile"), "a " + profile + " profile applies to fixedVelocity and flowRate patches only");
+    throw InputError(b.where("profile"),
+                     "a " + profile + " profile applies to fixedVelocity and flowRate patches only");
   bc.parabolicMin = vec3(b, "parabolicMin");
   bc.parabolicMax = vec3(b, "parabolicMax");
   if (b.has("valve")) {
@@ -157,32 +183,10 @@ PatchBC readBoundary(const SceneConfig& b) {
     bc.valve.openTo = b.get<double>("valve.openTo");
     if (!(bc.valve.openFrom < bc.valve.openTo && bc.valve.openTo <= bc.valve.period))
       throw InputError(b.where("valve"), "needs 0 <= openFrom < openTo <= period, got " +
-                                             std::to_string(bc.valve.openFrom) + ", " + std::to_string(bc.valve.openTo) +
-                                             ", " + std::to_string(bc.valve.period));
+                                             std::to_string(bc.valve.openFrom) + ", " +
+                                             std::to_string(bc.valve.openTo) + ", " + std::to_string(bc.valve.period));
   }
-  if (b.has("timeFunction")) {
-    const std::string tf = b.get<std::string>("timeFunction.type");
-    bc.timeFunction.kind = tf == "oneMinusCos"     ? TimeFunction::Kind::OneMinusCos
-                           : tf == "cosineRamp"    ? TimeFunction::Kind::CosineRamp
-                           : tf == "halfPowerSine" ? TimeFunction::Kind::HalfPowerSine
-                                                   : TimeFunction::Kind::Constant;
-    bc.timeFunction.period = b.get<double>("timeFunction.period");
-    bc.timeFunction.pulseDuration = b.get<double>("timeFunction.pulseDuration");
-    bc.timeFunction.exponent = b.get<double>("timeFunction.exponent");
-    bc.timeFunction.secondAmplitude = b.get<double>("timeFunction.secondAmplitude");
-    bc.timeFunction.secondDuration = b.get<double>("timeFunction.secondDuration");
-    if (bc.timeFunction.pulseDuration > bc.timeFunction.period)
-      throw InputError(b.where("timeFunction.pulseDuration"), "must not exceed the period");
-    const double first =
-        bc.timeFunction.pulseDuration > 0 ? bc.timeFunction.pulseDuration : 0.5 * bc.timeFunction.period;
-    if (bc.timeFunction.secondAmplitude != 0 && !(bc.timeFunction.secondDuration > 0))
-      throw InputError(b.where("timeFunction.secondDuration"), "a second pulse (secondAmplitude) needs a duration > 0");
-    if (bc.timeFunction.secondAmplitude != 0 && first + bc.timeFunction.secondDuration > bc.timeFunction.period * (1 + 1e-12))
-      throw InputError(b.where("timeFunction.secondDuration"),
-                       "the two pulses (" + std::to_string(first) + " + " +
-                           std::to_string(bc.timeFunction.secondDuration) + " s) must fit in the period (" +
-                           std::to_string(bc.timeFunction.period) + " s)");
-  }
+  if (b.has("timeFunction")) bc.timeFunction = readTimeFunction(b.child("timeFunction"));
   return bc;
 }
 
@@ -309,11 +313,13 @@ Schema fluidSchema() {
            Presence::Optional)
       .key("forces",
            Schema::list("patches whose force and moment are reported: every step in steps.csv (fluid.<patch>.force_x "
-                        "... moment_z, c_D and c_L) and at the end in summary.json", forceSchema()),
+                        "... moment_z, c_D and c_L) and at the end in summary.json",
+                        forceSchema()),
            Presence::Optional)
       .key("pressureDifferences",
            Schema::list("pressure differences reported every step in steps.csv (fluid.<name>) and at the end in "
-                        "summary.json", pressureDifferenceSchema()),
+                        "summary.json",
+                        pressureDifferenceSchema()),
            Presence::Optional)
       .key("probes",
            Schema::list("probes written every step (steps.csv columns fluid.probe.<name> for p, and "

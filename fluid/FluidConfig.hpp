@@ -38,6 +38,13 @@ namespace mfsi {
 /// Schema of the `fluid` section.
 Schema fluidSchema();
 
+/// \brief Schema of a time function f(t) (`fluid.boundary.<patch>.timeFunction`, and wherever
+/// another section prescribes a time history), described as `what`.
+Schema timeFunctionSchema(const std::string& what);
+/// \brief The time function a `timeFunctionSchema` section describes. Throws InputError naming the
+/// key for pulses that do not fit in the period.
+fluid::TimeFunction readTimeFunction(const SceneConfig& section);
+
 /// Options described by a view of the `fluid` section, checked against the patches of `mesh`.
 /// Throws InputError naming the scene key on semantic errors (unknown patch, a plain patch without
 /// a condition, both or neither of viscosity/nu, a parabolic profile without axes).

@@ -1,5 +1,7 @@
 #include "coupling/orchestrator/CouplingConfig.hpp"
 
+#include "fluid/FluidConfig.hpp"
+
 namespace mfsi {
 
 Schema couplingSchema() {
@@ -145,6 +147,14 @@ Schema couplingSchema() {
                            "force and moment on them load the body)",
                            Schema::list("fluid patches of the body", Schema::string("patch name"))),
            Presence::Optional)
+      .key("lumpedChamber",
+           Schema::map("a gas chamber behind a membrane patch that is not meshed (its inertia negligible, e.g. a "
+                       "pump's air chamber): one uniform pressure, the multiplier of a volume constraint on the "
+                       "membrane, and a volume that grows by the prescribed inflow (steps.csv: chamberPressure)")
+               .key("membrane", Schema::string("the membrane (a boundaryPatch membrane) the chamber lies behind"))
+               .key("flowRate", Schema::real("inflow into the chamber, times the time function", "m^3/s"))
+               .key("timeFunction", timeFunctionSchema("factor f(t) on the flow rate"), Presence::Optional),
+           Presence::OptionalSection)
       .key("parentBodyPatches",
            Schema::freeMap("membranes mounted on coupled bodies: membrane name -> patches of bodyPatches; each "
                            "membrane node follows the body of the nearest listed patch, its FEM displacement (and "
@@ -203,6 +213,12 @@ CouplingOptions readCouplingOptions(const SceneConfig& c) {
   o.motion.slidingPatches = c.get<std::vector<std::string>>("meshMotion.slidingPatches");
   for (const auto& name : c.keys("bodyPatches"))
     o.bodyPatches.push_back({name, c.get<std::vector<std::string>>("bodyPatches." + name)});
+  if (c.has("lumpedChamber")) {
+    o.lumpedChamber.membrane = c.get<std::string>("lumpedChamber.membrane");
+    o.lumpedChamber.flowRate = c.get<double>("lumpedChamber.flowRate");
+    if (c.has("lumpedChamber.timeFunction"))
+      o.lumpedChamber.timeFunction = readTimeFunction(c.child("lumpedChamber.timeFunction"));
+  }
   for (const auto& name : c.keys("parentBodyPatches"))
     o.parentBodyPatches.push_back({name, c.get<std::vector<std::string>>("parentBodyPatches." + name)});
   return o;

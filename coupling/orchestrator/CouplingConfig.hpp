@@ -20,6 +20,7 @@
 ///   fsiRampTime: 0          # load ramp 0 -> 100 % after fsiStartTime
 ///   outsidePressure: 0      # pressure behind a membrane that replaces a wall patch
 ///   volumeConstraint: true  # a membrane closing an incompressible fluid with no pressure boundary keeps its volume in step with the inflow
+///   lumpedChamber: {membrane: diaphragm, flowRate: 3.19e-4, timeFunction: {...}}  # an unmeshed gas chamber behind a membrane
 ///   meshMotion: {sweeps: 50, minScaledJacobian: 0.05}
 ///   bodyPatches: {piston: [pistonFace]}   # rigid bodies (the `bodies` section) and the fluid patches they carry
 ///   parentBodyPatches: {sail: [mast]}     # membranes mounted on those bodies (nearest listed patch)
@@ -27,6 +28,7 @@
 #include "core/SceneConfig.hpp"
 #include "coupling/acceleration/Acceleration.hpp"
 #include "coupling/motion/MeshSmoother.hpp"
+#include "fluid/FluidOptions.hpp"
 
 namespace mfsi {
 
@@ -65,6 +67,15 @@ struct CouplingOptions {
   /// A fluid domain with no pressure boundary (incompressible): the membrane patch that closes it
   /// solves with a volume constraint (coupling/interface/ChamberRegions).
   bool volumeConstraint = true;
+  /// \brief A gas chamber behind a membrane patch that is not meshed (its inertia negligible: the
+  /// pump's air chamber): one uniform pressure, the membrane's volume constraint's multiplier, and a
+  /// volume that grows by the integral of the prescribed inflow over each step.
+  struct LumpedChamber {
+    std::string membrane;  ///< empty: none
+    double flowRate = 0;   ///< m^3/s into the chamber, times the time function
+    fluid::TimeFunction timeFunction;
+  };
+  LumpedChamber lumpedChamber;
   /// Every coupling iteration's fluid solve starts from the step's start iterate (true) instead of
   /// the last iteration's answer: the fluid's answer is then a function of the interface alone,
   /// also where the fluid does not converge within its outer iterations.

@@ -132,7 +132,47 @@ FsiCoupling::FsiCoupling(const CouplingOptions& options, const SceneConfig& sect
   acceleration_ = coupling::makeAcceleration(options_.acceleration, layout);
 }
 
+std::vector<std::string> FsiCoupling::membraneNames() const {
+  std::vector<std::string> names;
+  for (const Panel& p : panels_) {  // the scene's names: module "membrane.<name>" -> "<name>"
+    const std::string& n = p.module->panel().name;
+    names.push_back(n.rfind("membrane.", 0) == 0 ? n.substr(9) : n);
+  }
+  return names;
+}
+
+void FsiCoupling::setUpLumpedChamber(const SceneConfig& section) {
+  const CouplingOptions::LumpedChamber& lc = options_.lumpedChamber;
+  const auto where = section.where("lumpedChamber.membrane");
+  const std::vector<std::string> names = membraneNames();
+  const auto it = std::find(names.begin(), names.end(), lc.membrane);
+  if (it == names.end())
+    throw InputError(where, "no coupled membrane '" + lc.membrane + "'" + didYouMean(lc.membrane, names) +
+                                "; membranes: " + joinList(names));
+  const int i = static_cast<int>(it - names.begin());
+  const Panel& p = panels_[i];
+  if (p.iface.side != coupling::InterfaceSide::Patch)
+    throw InputError(where, lc.membrane + " has fluid on both sides (a baffle): a lumped chamber lies behind a "
+                                          "membrane patch (mesh: {boundaryPatch: ...})");
+  if (!p.dynamic)
+    throw InputError(where, lc.membrane + ": a lumped chamber's volume constraint needs the dynamic analysis");
+  if (p.mounted) throw InputError(where, lc.membrane + ": a lumped chamber behind a mounted membrane is not supported yet");
+  if (chamber_.panel >= 0)
+    throw InputError(where, "the fluid also has a closed region; a second volume constraint is not supported yet");
+  chamber_.panel = i;
+  chamber_.lumped = true;
+  MembraneSolver& s = p.module->solver();
+  // The chamber lies on the side the element normals (out of the fluid) point into.
+  MembraneVolumeConstraint& vc = s.volumeConstraint();
+  vc.active = true;
+  vc.sign = -1;
+  vc.lambda = 0;
+  chamber_.volumeStart = s.enclosedVolume(s.displacement());
+  vc.target = chamber_.volumeStart;
+}
+
 void FsiCoupling::setUpChamber(const SceneConfig& section) {
+  if (!options_.lumpedChamber.membrane.empty()) setUpLumpedChamber(section);
   fluid::FluidSolver& f = fluid_->solver();
   // Artificial compressibility: the fluid takes a volume change itself.
   if (f.options().artificialCompressibility.soundSpeed > 0) return;
@@ -219,6 +259,18 @@ void FsiCoupling::beginChamberStep() {
   if (chamber_.panel < 0) return;
   // Every boundary face's flux sums to zero: the membrane's mesh flux (c1 dV^{n+1} - c00 dV^n) / dt
   // equals the prescribed inflow Q at t_n+1.
+  if (chamber_.lumped) {
+    // The inflow's integral over the step (composite Simpson on 64 intervals: the pump's pulses
+    // have square-root ends).
+    const CouplingOptions::LumpedChamber& lc = options_.lumpedChamber;
+    const fluid::FluidSolver& f = fluid_->solver();
+    const double t0 = f.time(), h = f.timeStep() / 64;
+    double sum = 0;
+    for (int k = 0; k <= 64; ++k) sum += (k == 0 || k == 64 ? 1 : k % 2 ? 4 : 2) * lc.timeFunction(t0 + k * h);
+    last_.volumeStep = lc.flowRate * sum * h / 3;
+    panels_[chamber_.panel].module->solver().volumeConstraint().target = chamber_.volumeStart + last_.volumeStep;
+    return;
+  }
   const fluid::FluidSolver& f = fluid_->solver();
   const fluid::FluidSolver::MeshFluxWeights w = f.meshFluxWeights();
   const double q = f.prescribedInflow(chamber_.fluidRegion);
@@ -284,19 +336,15 @@ void FsiCoupling::setUpBodies(const SceneConfig& section, std::vector<coupling::
 void FsiCoupling::setUpParents(const SceneConfig& section) {
   if (options_.parentBodyPatches.empty()) return;
   auto pts = Kokkos::create_mirror_view_and_copy(HostSpace(), whole_.points());  // the reference mesh
-  std::vector<std::string> membraneNames;
-  for (const Panel& p : panels_) {  // the scene's names: module "membrane.<name>" -> "<name>"
-    const std::string& n = p.module->panel().name;
-    membraneNames.push_back(n.rfind("membrane.", 0) == 0 ? n.substr(9) : n);
-  }
+  const std::vector<std::string> names = membraneNames();
   for (const auto& pp : options_.parentBodyPatches) {
     const std::string key = "parentBodyPatches." + pp.membrane;
-    auto it = std::find(membraneNames.begin(), membraneNames.end(), pp.membrane);
-    if (it == membraneNames.end())
+    auto it = std::find(names.begin(), names.end(), pp.membrane);
+    if (it == names.end())
       throw InputError(section.where(key), "no coupled membrane '" + pp.membrane + "'" +
-                                               didYouMean(pp.membrane, membraneNames) +
-                                               "; membranes: " + joinList(membraneNames));
-    Panel& p = panels_[static_cast<std::size_t>(it - membraneNames.begin())];
+                                               didYouMean(pp.membrane, names) +
+                                               "; membranes: " + joinList(names));
+    Panel& p = panels_[static_cast<std::size_t>(it - names.begin())];
     if (p.wallVelocity)
       throw InputError(section.where(key), "the fluid walls of " + pp.membrane +
                                                " must take the mesh velocity on a moving frame: make them "
@@ -729,11 +777,14 @@ void FsiCoupling::advance(const TimeState& t) {
       pa += areas[e] * h(e);
       a += areas[e];
     }
-    last_.chamberPressure = s.volumeConstraint().lambda + (a > 0 ? pa / a : 0.0);
+    // A lumped chamber's pressure is the multiplier over the outside pressure its membrane's load
+    // is taken against.
+    last_.chamberPressure = chamber_.lumped ? options_.outsidePressure + s.volumeConstraint().lambda
+                                            : s.volumeConstraint().lambda + (a > 0 ? pa / a : 0.0);
     chamber_.maxMissRun = std::max(chamber_.maxMissRun, last_.volumeMiss);
   }
   commitStructure();
-  if (chamber_.panel >= 0) {
+  if (chamber_.panel >= 0 && !chamber_.lumped) {
     // The fluid's pressure level in the chamber takes over the multiplier: its field is then the
     // physical pressure, and the next step's multiplier is the change of the level over it.
     Panel& p = panels_[chamber_.panel];

@@ -175,6 +175,9 @@ class FsiCoupling final : public Module {
   void setUpBodies(const SceneConfig& section, std::vector<coupling::InterfaceBlock>& layout);
   void setUpParents(const SceneConfig& section);
   void setUpChamber(const SceneConfig& section);
+  void setUpLumpedChamber(const SceneConfig& section);
+  /// The coupled membranes' names as the scene spells them ("<name>" of module "membrane.<name>").
+  std::vector<std::string> membraneNames() const;
 
   CouplingOptions options_;
   HexMesh& mesh_;
@@ -203,6 +206,7 @@ class FsiCoupling final : public Module {
   struct Chamber {
     int panel = -1;            ///< index into panels_; -1: no constraint
     int fluidRegion = -1;      ///< the fluid's closed region (FluidSolver::addClosedRegion); -1: the whole domain
+    bool lumped = false;       ///< an unmeshed gas chamber behind the membrane (coupling.lumpedChamber)
     double volumeStart = 0;    ///< the chamber's volume change where the fluid mesh is at the step's start
     double sweptLast = 0;      ///< what the membrane swept in the last step (the BDF2 mesh flux reads it)
     double maxMissRun = 0;     ///< largest volume miss of the run [m^3]

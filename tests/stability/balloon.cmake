@@ -8,47 +8,43 @@
 # 0.10 % on 32, second order). The fluid's pressure level is tied to the multiplier: its pressure
 # at the chamber's centre is the chamber pressure within 1 % at rest. Without the constraint the
 # fluid has no answer: the run must stop as diverged in its first step with the reason. The same
-# holds with an open chamber above the membrane (tests/data/balloon_two_chambers.yaml).
+# holds with an open chamber above the membrane (tests/data/balloon_two_chambers.yaml) and with the
+# gas chamber unmeshed, behind a membrane that closes an open fluid box
+# (tests/data/balloon_lumped.yaml, coupling.lumpedChamber).
 include(${CMAKE_CURRENT_LIST_DIR}/lib/Checks.cmake)
 file(REMOVE_RECURSE ${WORK})
 set(membrane top)
 
-# The run `name` at rest against the exact arc.
+# The run `name` at rest against the exact arc: the chamber pressure, the mid-point deflection
+# (its size: the lumped variant bulges down) and, where the scene has one, the fluid's pressure
+# probe in the chamber, each averaged over the last 40 steps (2 s: a residual slosh of the fluid
+# is one period or two).
 function(at_rest name)
   file(READ ${WORK}/${name}/summary.json s)
   string(JSON miss GET "${s}" metrics coupling.chamber_max_volume_miss)
   string(JSON volume GET "${s}" metrics coupling.chamber_volume)
-  string(JSON pressure GET "${s}" metrics coupling.chamber_pressure)
-  string(JSON deflection GET "${s}" metrics membrane.top.centreUy)
   string(JSON continuity GET "${s}" metrics fluid.continuity_sum)
   # The exact arc enclosing A = volume / depth over the span L = 1: half-angle t with
   # A = (2 t - sin 2 t) / (8 sin^2 t), R = 1 / (2 sin t), stretch l = t / sin t, and
   # p R = l E h (l^2 - 1) / 2 (E = 250, h = 0.002).
-  execute_process(COMMAND awk -v A=${volume} -v p=${pressure} -v w=${deflection} -v miss=${miss} -v c=${continuity} "BEGIN {
+  execute_process(COMMAND awk -F, -v A=${volume} -v miss=${miss} -v c=${continuity} "
+    NR == 1 { for (i = 1; i <= NF; ++i) col[$i] = i; next }
+    { P[NR] = $col[\"coupling.chamberPressure\"]; W[NR] = $col[\"membrane.top.centreUy\"]
+      Q[NR] = (\"fluid.probe.chamber\" in col) ? $col[\"fluid.probe.chamber\"] : 0; n = NR }
+    END {
+      for (k = n - 39; k <= n; ++k) { p += P[k] / 40; w += (W[k] < 0 ? -W[k] : W[k]) / 40; q += Q[k] / 40 }
       A = A / 0.05; lo = 1e-6; hi = 1.5
       for (i = 0; i < 200; ++i) { t = (lo + hi) / 2; a = (2 * t - sin(2 * t)) / (8 * sin(t)^2); if (a > A) hi = t; else lo = t }
       t = (lo + hi) / 2; R = 0.5 / sin(t); l = t / sin(t)
       pe = l * 250 * 0.002 * (l * l - 1) / 2 / R; we = R * (1 - cos(t))
       printf \"chamber pressure %.6g (exact arc %.6g, %+.2f %%), deflection %.6g (exact %.6g, %+.2f %%), volume miss %.3g, continuity %.3g\", p, pe, 100 * (p / pe - 1), w, we, 100 * (w / we - 1), miss, c
+      if (\"fluid.probe.chamber\" in col) printf \", fluid pressure at the chamber's centre %.6g (%+.2f %%)\", q, 100 * (q / p - 1)
       ok = (p > 0.985 * pe && p < 1.015 * pe && w > 0.994 * we && w < 1.006 * we && miss <= 1e-11 * A * 0.05 && c < 1e-12)
-      exit !ok }" OUTPUT_VARIABLE line RESULT_VARIABLE bad)
+      if (\"fluid.probe.chamber\" in col) ok = ok && q > 0.99 * p && q < 1.01 * p
+      exit !ok }" ${WORK}/${name}/steps.csv OUTPUT_VARIABLE line RESULT_VARIABLE bad)
   message(STATUS "| ${name} at rest | ${line} |")
   if(NOT bad EQUAL 0)
     message(SEND_ERROR "${name}: ${line}")
-  endif()
-  # The fluid's own pressure level is the chamber's (tied to the multiplier): the probe at the
-  # chamber's centre reads the chamber pressure at rest.
-  file(STRINGS ${WORK}/${name}/steps.csv rows)
-  list(GET rows 0 header)
-  list(GET rows -1 last)
-  string(REPLACE "," ";" header "${header}")
-  string(REPLACE "," ";" last "${last}")
-  list(FIND header fluid.probe.chamber column)
-  list(GET last ${column} probe)
-  execute_process(COMMAND awk "BEGIN { d = ${probe} / ${pressure} - 1; exit !(d < 0.01 && d > -0.01) }" RESULT_VARIABLE bad)
-  message(STATUS "| ${name} at rest | fluid pressure at the chamber's centre ${probe} (chamber ${pressure}) |")
-  if(NOT bad EQUAL 0)
-    message(SEND_ERROR "${name}: the fluid's pressure at the chamber's centre is ${probe}, the chamber's ${pressure}")
   endif()
 endfunction()
 
@@ -62,6 +58,11 @@ set(two ${CMAKE_CURRENT_LIST_DIR}/../data/balloon_two_chambers.yaml)
 stable(two_chambers 400 8 ${two})
 at_rest(two_chambers)
 diverges(two_chambers_unconstrained 400 ${two} --set coupling.volumeConstraint=false)
+
+# The balloon turned round: an unmeshed gas chamber (coupling.lumpedChamber) pushes the membrane
+# into an open fluid box; the same arc at rest, bulging down.
+stable(lumped 400 8 ${CMAKE_CURRENT_LIST_DIR}/../data/balloon_lumped.yaml)
+at_rest(lumped)
 
 # A restart from a checkpoint continues bitwise (the multiplier and the volume bookkeeping are
 # in the checkpoint): the last row of steps.csv, the wall time left out.
