@@ -4,6 +4,7 @@ written as Gmsh MSH 4.1 ASCII; SI units (m).
 
     python3 scripts/vad_mesh.py                         # cases/meshes/vad.msh
     python3 scripts/vad_mesh.py --around 16 --ring 2 --blood 4 --air 2 /tmp/vad_coarse.msh
+    python3 scripts/vad_mesh.py --blood-only /tmp/vad_blood.msh   # the blood chamber alone (air lumped)
     python3 scripts/vad_mesh.py --info                  # counts and quality only
 
 Geometry. Two domed chambers of width 2R = 7.7 cm separated by a membrane pinned at its rim
@@ -90,6 +91,9 @@ def main():
     ap.add_argument("--blood", type=int, default=10, help="layers in the blood chamber (default 10)")
     ap.add_argument("--air", type=int, default=5, help="layers in the air chamber (default 5)")
     ap.add_argument("--core", type=float, default=0.55, help="core square corner radius / R (default 0.55)")
+    ap.add_argument("--blood-only", action="store_true",
+                    help="the blood chamber alone, the membrane a boundary patch on top of it (for an air chamber "
+                         "the coupling lumps: coupling.lumpedChamber)")
     ap.add_argument("--info", action="store_true", help="print counts and quality, write nothing")
     a = ap.parse_args()
     if a.blood < 1 or a.air < 1:
@@ -97,12 +101,24 @@ def main():
     R, d, A, h = 0.0385, 0.0152, 0.0225, 0.002
     coords, cells, faces, z_m, pts2 = build(a.around, a.ring, a.blood, a.air, a.core, R, d, A, h,
                                             0.02, 0.0075, 0.004)
+    patches = PATCHES
+    if a.blood_only:
+        # Drop the air layers: the membrane faces become the blood chamber's top boundary.
+        nq = len(faces["membrane"])
+        cells = cells[:a.blood * nq]
+        used = np.unique(cells)
+        renumber = -np.ones(len(coords), dtype=np.int64)
+        renumber[used] = np.arange(len(used))
+        coords, cells = coords[used], renumber[cells]
+        faces = {p: renumber[faces[p]] for p in ("bloodInlet", "bloodOutlet", "bloodWall", "membrane")}
+        patches = ["bloodInlet", "bloodOutlet", "bloodWall", "membrane"]
+        a.air = 0
     sj = min_scaled_jacobian(coords, cells)
     if not sj > 0.0:
         sys.exit("inverted cell (min scaled Jacobian %g)" % sj)
     n2 = len(pts2)
 
-    def chamber_volume(k0, k1):
+    def chamber_volume(k0, k1):  # noqa: E306
         """Volume between node layers k0 and k1 (sum of the cells' trilinear volumes, midpoint rule)."""
         v = 0.0
         for cell in cells:
@@ -118,7 +134,7 @@ def main():
             % (len(cells), len(coords), a.around, a.ring, a.blood, a.air, sj,
                chamber_volume(0, a.blood) * 1e6, chamber_volume(a.blood, a.blood + a.air) * 1e6))
     if not a.info:
-        write_hex_msh(a.output, PATCHES, coords, cells, faces, (-R, -R, -A, R, R, A), VOLUME_TAG)
+        write_hex_msh(a.output, patches, coords, cells, faces, (-R, -R, -A, R, R, A), VOLUME_TAG)
         line += "\n  -> %s (%.0f kB; faces %s)" % (a.output, os.path.getsize(a.output) / 1e3,
                                                    {p: len(f) for p, f in faces.items()})
     print(line)
