@@ -201,6 +201,11 @@ void FsiCoupling::setUpChamber(const SceneConfig& section) {
     return;
   }
   const auto where = section.where("volumeConstraint");
+  if (chamber_.lumped)
+    throw InputError(where, "the fluid has a region no pressure boundary reaches besides the lumped chamber behind " +
+                                options_.lumpedChamber.membrane +
+                                ": a second volume constraint is not supported yet; give that region a pressure "
+                                "boundary");
   if (nClosed > 1)
     throw InputError(where, "the fluid mesh has " + std::to_string(nClosed) +
                                 " regions no pressure boundary reaches: one volume constraint per region is not "
@@ -257,8 +262,6 @@ void FsiCoupling::setUpChamber(const SceneConfig& section) {
 
 void FsiCoupling::beginChamberStep() {
   if (chamber_.panel < 0) return;
-  // Every boundary face's flux sums to zero: the membrane's mesh flux (c1 dV^{n+1} - c00 dV^n) / dt
-  // equals the prescribed inflow Q at t_n+1.
   if (chamber_.lumped) {
     // The inflow's integral over the step (composite Simpson on 64 intervals: the pump's pulses
     // have square-root ends).
@@ -271,6 +274,8 @@ void FsiCoupling::beginChamberStep() {
     panels_[chamber_.panel].module->solver().volumeConstraint().target = chamber_.volumeStart + last_.volumeStep;
     return;
   }
+  // Every boundary face's flux sums to zero: the membrane's mesh flux (c1 dV^{n+1} - c00 dV^n) / dt
+  // equals the prescribed inflow Q at t_n+1.
   const fluid::FluidSolver& f = fluid_->solver();
   const fluid::FluidSolver::MeshFluxWeights w = f.meshFluxWeights();
   const double q = f.prescribedInflow(chamber_.fluidRegion);
