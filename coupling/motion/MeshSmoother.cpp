@@ -1,6 +1,7 @@
 #include "coupling/motion/MeshSmoother.hpp"
 
 #include "core/Error.hpp"
+#include "core/PointTree.hpp"
 
 #include <algorithm>
 #include <array>
@@ -181,8 +182,9 @@ MeshSmoother::MeshSmoother(const HexMesh& mesh, const MeshSmootherOptions& optio
 void MeshSmoother::setMovingNodes(const std::vector<std::array<real, 3>>& points) {
   const double q = options_.distanceExponent;
   if (!(q > 0) || points.empty()) return;
-  // Host, once: the distance of every edge midpoint from the nearest moving node (brute force over
-  // the moving nodes, a surface's worth), floored at the edge's own length.
+  // Host, once: the distance of every edge midpoint from the nearest moving node (a k-d tree of the
+  // moving nodes), floored at the edge's own length.
+  const PointTree tree(points);
   auto off = Kokkos::create_mirror_view_and_copy(HostSpace(), mesh_.nodeNodeOffsets());
   auto nb = Kokkos::create_mirror_view_and_copy(HostSpace(), mesh_.nodeNodes());
   auto X = Kokkos::create_mirror_view_and_copy(HostSpace(), mesh_.referencePoints());
@@ -192,17 +194,13 @@ void MeshSmoother::setMovingNodes(const std::vector<std::array<real, 3>>& points
   for (lid_t i = 0; i < mesh_.nNodes(); ++i)
     for (lid_t k = off(i); k < off(i + 1); ++k) {
       const lid_t j = nb(k);
-      double m[3], len2 = 0;
+      std::array<real, 3> m;
+      double len2 = 0;
       for (int c = 0; c < 3; ++c) {
         m[c] = 0.5 * (X(i, c) + X(j, c));
         len2 += (X(i, c) - X(j, c)) * (X(i, c) - X(j, c));
       }
-      double d2 = 1e300;
-      for (const auto& p : points) {
-        const double dx = p[0] - m[0], dy = p[1] - m[1], dz = p[2] - m[2];
-        d2 = std::min(d2, dx * dx + dy * dy + dz * dz);
-      }
-      const double d = std::sqrt(std::max(d2, len2));
+      const double d = std::sqrt(std::max(tree.nearestSquaredDistance(m), len2));
       h(k) = w(k) / std::pow(d, q);
     }
   Kokkos::deep_copy(scaled, h);
