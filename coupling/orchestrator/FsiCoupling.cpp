@@ -159,13 +159,17 @@ void FsiCoupling::setUpLumpedChamber(const SceneConfig& section) {
   if (p.mounted) throw InputError(where, lc.membrane + ": a lumped chamber behind a mounted membrane is not supported yet");
   if (chamber_.panel >= 0)
     throw InputError(where, "the fluid also has a closed region; a second volume constraint is not supported yet");
-  chamber_.panel = i;
   chamber_.lumped = true;
-  MembraneSolver& s = p.module->solver();
   // The chamber lies on the side the element normals (out of the fluid) point into.
+  activateChamber(i, -1);
+}
+
+void FsiCoupling::activateChamber(int panel, real sign) {
+  chamber_.panel = panel;
+  MembraneSolver& s = panels_[panel].module->solver();
   MembraneVolumeConstraint& vc = s.volumeConstraint();
   vc.active = true;
-  vc.sign = -1;
+  vc.sign = sign;
   vc.lambda = 0;
   chamber_.volumeStart = s.enclosedVolume(s.displacement());
   vc.target = chamber_.volumeStart;
@@ -249,15 +253,9 @@ void FsiCoupling::setUpChamber(const SceneConfig& section) {
                             "level is undefined; give it a pressure boundary or artificial compressibility");
   }
   if (!f.closedDomain()) chamber_.fluidRegion = registerRegion(region);
-  MembraneSolver& s = panels_[chamber_.panel].module->solver();
   // The membrane's element normals are the fluid faces' area vectors (the master side's on a
   // baffle; coupling/interface/MembraneInterface).
-  MembraneVolumeConstraint& vc = s.volumeConstraint();
-  vc.active = true;
-  vc.sign = sign;
-  vc.lambda = 0;
-  chamber_.volumeStart = s.enclosedVolume(s.displacement());
-  vc.target = chamber_.volumeStart;
+  activateChamber(chamber_.panel, sign);
 }
 
 void FsiCoupling::beginChamberStep() {

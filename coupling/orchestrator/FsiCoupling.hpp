@@ -176,6 +176,9 @@ class FsiCoupling final : public Module {
   void setUpParents(const SceneConfig& section);
   void setUpChamber(const SceneConfig& section);
   void setUpLumpedChamber(const SceneConfig& section);
+  /// Panel `panel` closes the chamber (sign: MembraneVolumeConstraint::sign): its constraint is
+  /// switched on at the volume it has now.
+  void activateChamber(int panel, real sign);
   /// The coupled membranes' names as the scene spells them ("<name>" of module "membrane.<name>").
   std::vector<std::string> membraneNames() const;
 
