@@ -112,6 +112,14 @@ Schema couplingSchema() {
       .key("outsidePressure",
            Schema::real("pressure behind a membrane that replaces a boundary patch (its load is p - this)", "Pa"),
            Default(o.outsidePressure))
+      .key("interfaceMass",
+           Schema::real("artificial added mass on the membranes in each coupling iteration, taken back at "
+                        "convergence (the converged answer is the same): about the fluid's density times the "
+                        "depth of fluid a membrane moves; stabilises light membranes in dense fluid (0: off; "
+                        "implicit scheme only)",
+                        "kg/m^2")
+               .atLeast(0),
+           Default(o.interfaceMass))
       .key("maxMeshVelocity",
            Schema::real("limit of a coupled body's centre-of-mass move per coupling iteration, divided by the time "
                         "step (0: off)",
@@ -195,6 +203,11 @@ CouplingOptions readCouplingOptions(const SceneConfig& c) {
   o.fsiRampTime = c.get<double>("fsiRampTime");
   o.pClamp = c.get<double>("pClamp");
   o.outsidePressure = c.get<double>("outsidePressure");
+  o.interfaceMass = c.get<double>("interfaceMass");
+  if (o.interfaceMass > 0 && o.scheme == CouplingScheme::Explicit)
+    throw InputError(c.where("interfaceMass"),
+                     "interfaceMass needs 'scheme: implicit': its term vanishes only when the coupling iteration "
+                     "has converged, which the explicit scheme never checks");
   o.viscousTraction = c.get<bool>("viscousTraction");
   o.volumeConstraint = c.get<bool>("volumeConstraint");
   o.fluidFromStepStart = c.get<std::string>("fluidStart") == "stepStart";

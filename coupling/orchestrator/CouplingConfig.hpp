@@ -19,6 +19,7 @@
 ///   fsiStartTime: 0         # structure frozen before this time
 ///   fsiRampTime: 0          # load ramp 0 -> 100 % after fsiStartTime
 ///   outsidePressure: 0      # pressure behind a membrane that replaces a wall patch
+///   interfaceMass: 0        # artificial added mass (kg/m^2) of a coupling iteration, gone at convergence
 ///   volumeConstraint: true  # a membrane closing an incompressible fluid with no pressure boundary keeps its volume in step with the inflow
 ///   lumpedChamber: {membrane: diaphragm, flowRate: 3.19e-4, timeFunction: {...}}  # an unmeshed gas chamber behind a membrane
 ///   meshMotion: {sweeps: 50, minScaledJacobian: 0.05}
@@ -58,6 +59,7 @@ struct CouplingOptions {
   double fsiRampTime = 0;     ///< s
   double pClamp = 0;          ///< |pNet| limit [Pa] (0: none)
   double outsidePressure = 0; ///< Pa
+  double interfaceMass = 0;   ///< kg/m^2: artificial added mass of a coupling iteration (0: off)
   /// Limit of a body's centre-of-mass move per coupling iteration, over the time step [m/s] (0: off).
   double maxMeshVelocity = 0;
   /// Limit of a membrane node's move per coupling iteration, as a fraction of the membrane's

@@ -74,6 +74,12 @@ FsiCoupling::FsiCoupling(const CouplingOptions& options, const SceneConfig& sect
                                         baffle ? coupling::InterfaceSide::Baffle : coupling::InterfaceSide::Patch);
     p.iface = p.surface.gatheredInterface();
     p.dynamic = po.analysis == MembraneAnalysis::Dynamic;
+    if (options_.interfaceMass > 0) {
+      if (!p.dynamic)
+        throw InputError(section.where("interfaceMass"),
+                         "interfaceMass acts on a membrane's inertia: " + m->name() + " has 'analysis: static'");
+      m->solver().setInterfaceMass(options_.interfaceMass);
+    }
     // The fluid walls on the membrane must move with it: either they take the membrane velocity
     // (membraneWall: External), or the mesh velocity (movingWall).
     for (int pi : bc.find(surface)) {

@@ -118,7 +118,15 @@ Schema panelSchema() {
                Default(0))
           .key("characteristicLength",
                Schema::real("length of the displacement limiters (0: sqrt(area))", "m").atLeast(0),
-               Default(o.characteristicLength));
+               Default(o.characteristicLength))
+          .key("tangentStressFloor",
+               Schema::real("tangent-only floor of the smallest principal membrane force, as a fraction of E h: "
+                            "gives a flat unstressed sheet a first Newton matrix and keeps compressed ones positive "
+                            "definite; 0: the exact tangent (quadratic Newton; a time step's mass keeps its matrix "
+                            "definite unless the sheet carries compression, i.e. with tension-field wrinkling)",
+                            "-")
+                   .atLeast(0),
+               Default(o.newton.tangentStressFloor));
   Schema dynamics =
       Schema::map("implicit time integration (analysis: dynamic)")
           .key("integrator", Schema::choice("time integrator", {"newmark", "generalizedAlpha"}), Default("newmark"))
@@ -371,6 +379,7 @@ MembranePanelOptions readPanel(const SceneConfig& p, std::size_t index, std::siz
   if (const int it = p.get<int>("solver.maxIterations"); it > 0)
     opt.newton.maxIterations = opt.lumped.maxIterations = it;
   opt.characteristicLength = p.get<double>("solver.characteristicLength");
+  opt.newton.tangentStressFloor = p.get<double>("solver.tangentStressFloor");
   opt.dynamics.integrator = p.get<std::string>("dynamics.integrator") == "generalizedAlpha"
                                 ? MembraneTimeIntegrator::GeneralizedAlpha
                                 : MembraneTimeIntegrator::Newmark;

@@ -631,6 +631,23 @@ void MembraneSolver::commitStep() {
 
 void MembraneSolver::discardStep() { trial_ = {}; }
 
+void MembraneSolver::setInterfaceMass(real massPerArea) {
+  MFSI_CHECK(std::isfinite(massPerArea) && massPerArea >= 0,
+             "membrane: the interface mass must be finite and >= 0, got " << massPerArea);
+  interfaceMass_ = massPerArea;
+  if (massPerArea == 0) return;
+  const lid_t n3 = 3 * mesh_.nNodes();
+  MFSI_CHECK(options_.material.density > 0 && options_.material.thickness > 0,
+             "membrane: an interface mass needs density and thickness > 0");
+  // The lumped mass rho h A_i per dof, scaled to massPerArea A_i.
+  interfaceNodeMass_ = RealView("mfsi::structure::membrane::interfaceNodeMass", n3);
+  anchor_ = RealView("mfsi::structure::membrane::interfaceAnchor", n3);
+  membraneMassItems(exec_, data_, nItems_, true, itemVec_);
+  gatherItemVectors(exec_, map_, itemVec_, interfaceNodeMass_);
+  blas::axpby(exec_, n3, massPerArea / (options_.material.density * options_.material.thickness),
+              interfaceNodeMass_, 0.0, interfaceNodeMass_);
+}
+
 MembraneSolveReport MembraneSolver::step(real dt) {
   const MembraneSolveReport rep = solveStep(dt);
   if (rep.converged) commitStep();
@@ -725,6 +742,8 @@ MembraneSolveReport MembraneSolver::solveStep(real dt) {
   clampTargets(t1);
   Kokkos::deep_copy(exec_, clampStart_, clampTarget_);
   applyClamps(uTrial_, 1);
+  const bool withInterfaceMass = interfaceMass_ > 0;
+  if (withInterfaceMass) Kokkos::deep_copy(exec_, anchor_, uTrial_);  // a_1* (see setInterfaceMass)
 
   const RealView a1 = a1_, v1 = v1_, rhs = rhs_;
   const real cM = (1 - am) / (beta * dt * dt), cC = (1 - af) * gamma / (beta * dt);
@@ -748,6 +767,15 @@ MembraneSolveReport MembraneSolver::solveStep(real dt) {
       blas::axpby(exec_, n3, af, v_, 1 - af, work_);
       damping(work_, dampingForce_);
       blas::axpy(exec_, n3, -1.0, dampingForce_, rhs);
+    }
+    if (withInterfaceMass) {
+      // - m_i (1 - am)(a_1 - a_1*) = - cM m_i (u_1 - u_1*): the accelerations share u_n, v_n, a_n.
+      auto mi = interfaceNodeMass_;
+      auto anchor = anchor_;
+      auto u1 = uTrial_;
+      Kokkos::parallel_for(
+          "mfsi::structure::membrane::interfaceInertia", RangePolicy(exec_, 0, n3),
+          KOKKOS_LAMBDA(lid_t i) { rhs(i) -= cM * mi(i) * (u1(i) - anchor(i)); });
     }
     const Norms nrm = norms(rhs);
     const real scale = std::max({nrm.external, nrm.reaction, inertia, residualFloor() / options_.tolerance});
@@ -782,6 +810,13 @@ MembraneSolveReport MembraneSolver::solveStep(real dt) {
         Kokkos::parallel_for(
             "mfsi::structure::membrane::effectiveLumped", RangePolicy(exec_, 0, n3),
             KOKKOS_LAMBDA(lid_t i) { K(diag(i)) += (cM + cC * ra) * m(i); });
+      }
+      if (withInterfaceMass) {
+        auto diag = K_.diagIdx;
+        auto mi = interfaceNodeMass_;
+        Kokkos::parallel_for(
+            "mfsi::structure::membrane::effectiveInterface", RangePolicy(exec_, 0, n3),
+            KOKKOS_LAMBDA(lid_t i) { K(diag(i)) += cM * mi(i); });
       }
     }
     const real eta = std::min<real>(1e-2, std::max<real>(std::min<real>(rel, 1e-2), 0.5 * options_.tolerance / rel));

@@ -120,6 +120,17 @@ class MembraneSolver {
     lambdaCommitted_ += delta;
   }
 
+  /// \brief Artificial added mass of an FSI coupling iteration [kg/m^2] (0: off). Each `solveStep`
+  /// then adds m_i (a_1 - a_1*) to the inertia, m_i = massPerArea x the node's lumped area, with
+  /// a_1* the acceleration of the displacement the solve starts from (the interface iterate the
+  /// fluid saw, in a coupling iteration: `setTrialDisplacement`). The term vanishes once the
+  /// coupling has converged (the solve then returns the displacement it started from), so the
+  /// answer is unchanged; what changes is the fixed-point map: a light membrane in a dense fluid
+  /// no longer answers a pressure change with the large move that only the fluid's added mass,
+  /// which the partitioned structure solve does not see, would hold back.
+  void setInterfaceMass(real massPerArea);
+  real interfaceMass() const { return interfaceMass_; }
+
   real time() const { return time_; }
   void setTime(real t) { time_ = t; }
   /// Displacement (writable: initial conditions); call `resetDynamics()` after editing u or v.
@@ -239,6 +250,8 @@ class MembraneSolver {
   MembraneVolumeConstraint volume_;
   real lambdaCommitted_ = 0;  ///< the multiplier at time(): generalized-alpha's R_n carries it
   RealView volumeGrad_, volumeDu_;  ///< g and b of the constrained Newton step
+  real interfaceMass_ = 0;            ///< artificial added mass per area (setInterfaceMass)
+  RealView interfaceNodeMass_, anchor_;  ///< its lumped nodal masses; the displacement a solve starts from
   RealView pElem_, pElemScaled_;  ///< element pressure in use (the load field, or a scaled copy)
   // Clamps: node ids, reference-frame targets at the requested time, start values of a load ramp.
   IndexView clampNodes_;
