@@ -119,6 +119,11 @@ Schema panelSchema() {
           .key("characteristicLength",
                Schema::real("length of the displacement limiters (0: sqrt(area))", "m").atLeast(0),
                Default(o.characteristicLength))
+          .key("lineSearchSteps",
+               Schema::integer("residual evaluations a Newton step may add to find the root of du . R along it "
+                               "(static solves and time steps; 0: the full step)")
+                   .atLeast(0),
+               Default(o.newton.maxLineSearchSteps))
           .key("tangentStressFloor",
                Schema::real("tangent-only floor of the smallest principal membrane force, as a fraction of E h: "
                             "gives a flat unstressed sheet a first Newton matrix and keeps compressed ones positive "
@@ -380,6 +385,7 @@ MembranePanelOptions readPanel(const SceneConfig& p, std::size_t index, std::siz
     opt.newton.maxIterations = opt.lumped.maxIterations = it;
   opt.characteristicLength = p.get<double>("solver.characteristicLength");
   opt.newton.tangentStressFloor = p.get<double>("solver.tangentStressFloor");
+  opt.newton.maxLineSearchSteps = p.get<int>("solver.lineSearchSteps");
   opt.dynamics.integrator = p.get<std::string>("dynamics.integrator") == "generalizedAlpha"
                                 ? MembraneTimeIntegrator::GeneralizedAlpha
                                 : MembraneTimeIntegrator::Newmark;

@@ -61,6 +61,7 @@ MembraneSolver::MembraneSolver(const MembraneMesh& mesh, const MembraneOptions& 
   dampingForce_ = RealView("mfsi::structure::membrane::dampingForce", n3);
   volumeGrad_ = RealView("mfsi::structure::membrane::volumeGradient", n3);
   volumeDu_ = RealView("mfsi::structure::membrane::volumeDu", n3);
+  lineStart_ = RealView("mfsi::structure::membrane::lineStart", n3);
   setupItems();
   setupConstraints();
   setupClamps();
@@ -751,11 +752,11 @@ MembraneSolveReport MembraneSolver::solveStep(real dt) {
   const auto& nopt = options_.newton;
   const bool constrained = volume_.active;
   const real volumeTol = volume_.tolerance * mesh_.referenceArea() * lchar_;
-  real rel = 1;
-  for (int it = 0; it < nopt.maxIterations; ++it) {
+  // The step's residual at the trial displacement (and the multiplier): rhs = (1-af) R1 + af Rn
+  // - M((1-am) a1 + am an) - C((1-af) v1 + af vn) [- the interface mass term]. Returns |M a_mid|.
+  auto stepResidual = [&]() {
     kinematics();
     evalResidual(uTrial_, t1, 1);
-    // rhs = (1-af) R1 + af Rn - M((1-am) a1 + am an) - C((1-af) v1 + af vn)
     Kokkos::deep_copy(exec_, work_, a1);
     blas::axpby(exec_, n3, am, a_, 1 - am, work_);
     mass(work_, rhs);  // rhs = M a_mid (inertia)
@@ -777,6 +778,14 @@ MembraneSolveReport MembraneSolver::solveStep(real dt) {
           "mfsi::structure::membrane::interfaceInertia", RangePolicy(exec_, 0, n3),
           KOKKOS_LAMBDA(lid_t i) { rhs(i) -= cM * mi(i) * (u1(i) - anchor(i)); });
     }
+    return inertia;
+  };
+  real rel = 1;
+  bool fresh = false;  // rhs_ already holds the residual at uTrial_ (the line search's last evaluation)
+  real inertia = 0;
+  for (int it = 0; it < nopt.maxIterations; ++it) {
+    if (!fresh) inertia = stepResidual();
+    fresh = false;
     const Norms nrm = norms(rhs);
     const real scale = std::max({nrm.external, nrm.reaction, inertia, residualFloor() / options_.tolerance});
     rel = scale > 0 ? nrm.free / scale : (nrm.free > 0 ? 1.0 : 0.0);
@@ -822,6 +831,7 @@ MembraneSolveReport MembraneSolver::solveStep(real dt) {
     const real eta = std::min<real>(1e-2, std::max<real>(std::min<real>(rel, 1e-2), 0.5 * options_.tolerance / rel));
     const MembraneCgResult cg = cg_.solve(exec_, K_, constraints_, rhs, du_, eta, nopt.cgMaxIterations);
     rep.linearIterations += cg.iterations;
+    real dLambdaStep = 0;
     if (constrained) {
       // du = a + dlambda b with A a = rhs (just solved), A b = (1 - af) g; g . du = -c.
       blas::axpby(exec_, n3, 1 - af, volumeGrad_, 0.0, volumeGrad_);
@@ -832,10 +842,50 @@ MembraneSolveReport MembraneSolver::solveStep(real dt) {
       if (!(gb > 0)) break;  // the volume does not respond to the free nodes
       const real dLambda = -(volumeMiss + ga) / gb;
       blas::axpy(exec_, n3, dLambda, volumeDu_, du_);
-      volume_.lambda += dLambda;
+      dLambdaStep = dLambda;
     }
-    blas::axpy(exec_, n3, 1.0, du_, uTrial_);
     ++rep.iterations;
+    // Line search on g(alpha) = du . rhs(u + alpha du, lambda + alpha dlambda), as in the static
+    // solve: the full step when it halves g, else the root of g by secant and regula falsi. A
+    // time step's matrix is definite, but the tension-field law switches a point between taut,
+    // wrinkled and slack, where the tangent jumps by E h: a full Newton step from a slack region
+    // can overshoot into a stiff one and back, step after step.
+    const real g0 = blas::dot(exec_, SolverComm{}, n3, du_, rhs);
+    Kokkos::deep_copy(exec_, lineStart_, uTrial_);
+    const real lambdaStart = volume_.lambda;
+    auto tryStep = [&](real alpha) {
+      Kokkos::deep_copy(exec_, uTrial_, lineStart_);
+      blas::axpy(exec_, n3, alpha, du_, uTrial_);
+      volume_.lambda = lambdaStart + alpha * dLambdaStep;
+      inertia = stepResidual();
+      return blas::dot(exec_, SolverComm{}, n3, du_, rhs);
+    };
+    real alpha = 1, lo = 0, gLo = g0, hi = -1, gHi = 0, bestAlpha = 1, bestG = -1;
+    for (int evals = 1;; ++evals) {
+      const real g = tryStep(alpha);
+      if (std::isfinite(g) && (bestG < 0 || std::abs(g) < bestG)) {
+        bestG = std::abs(g);
+        bestAlpha = alpha;
+      }
+      if (!(g0 > 0) || (std::isfinite(g) && std::abs(g) <= 0.5 * g0)) break;
+      if (evals > nopt.maxLineSearchSteps) {
+        if (alpha != bestAlpha) tryStep(bestAlpha);
+        break;
+      }
+      ++rep.lineSearchSteps;
+      if (std::isfinite(g) && g > 0) {
+        // The root lies beyond alpha: extrapolate (at most 4x), or interpolate in a bracket.
+        lo = alpha;
+        gLo = g;
+        alpha = hi > 0 ? lo + (hi - lo) * gLo / (gLo - gHi) : std::min<real>(g < g0 ? alpha * g0 / (g0 - g) : 4 * alpha, 4 * alpha);
+      } else {
+        hi = alpha;
+        gHi = std::isfinite(g) ? g : -10 * g0;
+        const real t = gLo / (gLo - gHi);
+        alpha = lo + (hi - lo) * std::min<real>(0.9, std::max<real>(0.1, t));
+      }
+    }
+    fresh = true;
   }
   if (!rep.converged) kinematics();  // the trial velocity matches the trial displacement
   exec_.fence();

@@ -250,6 +250,7 @@ class MembraneSolver {
   MembraneVolumeConstraint volume_;
   real lambdaCommitted_ = 0;  ///< the multiplier at time(): generalized-alpha's R_n carries it
   RealView volumeGrad_, volumeDu_;  ///< g and b of the constrained Newton step
+  RealView lineStart_;  ///< the Newton iterate a time step's line search starts from
   real interfaceMass_ = 0;            ///< artificial added mass per area (setInterfaceMass)
   RealView interfaceNodeMass_, anchor_;  ///< its lumped nodal masses; the displacement a solve starts from
   RealView pElem_, pElemScaled_;  ///< element pressure in use (the load field, or a scaled copy)

@@ -10,7 +10,7 @@ set(cavity flexible-cavity --set mesh.blocks.0.cells=[12,10,1] --set mesh.blocks
 stable(ratio1 30 6 ${cavity})
 stable(ratio0.1 30 10 ${cavity} --set membranes.0.material.density=50)
 diverges(ratio0.1_explicit 30 ${cavity} --set membranes.0.material.density=50 --set coupling.scheme=explicit)
-stable(ratio0.01_no_shear 30 30 ${cavity} --set membranes.0.material.density=5 --set coupling.viscousTraction=false)
+stable(ratio0.01_no_shear 30 40 ${cavity} --set membranes.0.material.density=5 --set coupling.viscousTraction=false)
 diverges(ratio0.01_plain 30 ${cavity} --set membranes.0.material.density=5)
 stable(ratio0.01 30 30 ${cavity} --set membranes.0.material.density=5 --set coupling.interfaceMass=0.3)
 diverges(ratio0.001_plain 30 ${cavity} --set membranes.0.material.density=0.5)

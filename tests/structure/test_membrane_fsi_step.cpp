@@ -1,3 +1,6 @@
+// What a membrane time step needs inside an FSI coupling: the artificial interface mass and the
+// line search.
+//
 // The artificial added mass of a coupling iteration (MembraneSolver::setInterfaceMass): a step
 // solved from a start displacement u* adds m_a (a_1 - a_1*) to the inertia. On a pre-stressed
 // square under a step pressure:
@@ -108,4 +111,47 @@ TEST(MembraneInterfaceMass, RefusesANegativeMass) {
   MembraneSolver s(sq.mesh, sq.opt, sq.bc, sq.loads);
   EXPECT_THROW(s.setInterfaceMass(-1.0), std::exception);
   EXPECT_THROW(s.setInterfaceMass(std::nan("")), std::exception);
+}
+
+// The time step's line search (MembraneNewtonOptions::maxLineSearchSteps): a stress-free dome of
+// tension-field membrane (the pump's: radius 4 cm, 1.5 cm high, E h = 1.4e5 N/m, rho h = 0.275
+// kg/m^2) pushed from its convex side, with the exact tangent (no safeguard stiffness, no stress
+// floor). The push compresses the dome: it goes slack, snaps through and stiffens again where it
+// stretches, and the tangent jumps between the mass alone and E h. With the line search ten steps
+// of 1 ms converge and carry the dome through (the centre past the dome's mirror image, below
+// -1.5 cm, and not beyond -3.5 cm); with full Newton steps the first step already fails.
+TEST(MembraneStepLineSearch, DomeSnapsThroughUnderPressureOnItsConvexSide) {
+  for (double P : {100.0, 1000.0}) {
+    for (int steps : {0, 12}) {
+      MembraneDiscSpec disc;
+      disc.radius = 0.04;
+      disc.nCore = disc.nRing = 6;
+      MembraneMeshInput in = generateDiscMesh(disc);
+      for (auto& X : in.points) X[2] = 0.015 * std::cos(0.5 * M_PI * std::hypot(X[0], X[1]) / disc.radius);
+      const MembraneMesh mesh = buildMembraneMesh(in);
+      MembraneBoundary bc;
+      bc.clamps.push_back({mesh.nodeSet("boundary"), {}, {}});
+      MembraneOptions opt;
+      opt.material = {5.5e8, 0.3, 2.5e-4, 1100, 0};  // E, nu, h, rho, T0
+      opt.wrinkling = MembraneWrinklingModel::TensionField;
+      opt.wrinklingStiffnessFraction = 0;
+      opt.newton.tangentStressFloor = 0;
+      opt.newton.maxLineSearchSteps = steps;
+      opt.tolerance = 1e-9;
+      MembraneLoads loads;
+      loads.pressure = -P;  // against the normal (+z at the apex): onto the convex side
+      MembraneSolver s(mesh, opt, bc, loads);
+      int done = 0;
+      for (; done < 10; ++done)
+        if (!s.step(0.001).converged) break;
+      if (steps == 0) {
+        EXPECT_LT(done, 10) << P << " Pa: full Newton steps got through (the case no longer proves the search)";
+      } else {
+        EXPECT_EQ(done, 10) << P << " Pa";
+        const double w = s.summary().at("centreDeflection");
+        EXPECT_LT(w, -0.015) << P << " Pa";
+        EXPECT_GT(w, -0.035) << P << " Pa";
+      }
+    }
+  }
 }
