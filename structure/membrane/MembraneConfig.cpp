@@ -15,8 +15,8 @@ namespace mfsi {
 
 namespace {
 
-Schema timeSchema() {
-  return Schema::map("multiplier f(t) of the uniform pressure")
+Schema timeSchema(const std::string& what = "multiplier f(t) of the uniform pressure") {
+  return Schema::map(what)
       .key("shape",
            Schema::choice("constant: 1; ramp: min(1, t/rampTime); sine: offset + amplitude sin(omega t + phase); "
                           "pulse: 1 for t < duration, then 0",
@@ -178,6 +178,15 @@ Schema panelSchema() {
                Presence::Optional)
           .key("springs", Schema::list("node springs", spring), Presence::Optional)
           .key("edgeBeams", Schema::list("edge reinforcements", beam), Presence::Optional)
+          .key("clampMotion",
+               Schema::list("clamped node sets that move: each node to X + translation f(t) (a frame's edge "
+                            "closing in, stretching or compressing the sheet); a node of a moving set leaves "
+                            "the fixed clamps (boundary.clamp)",
+                            Schema::map("a moving clamp")
+                                .key("nodes", Schema::string("node set"))
+                                .key("translation", Schema::realVector(3, "displacement at f = 1", "m"))
+                                .key("time", timeSchema("multiplier f(t) of the translation"), Presence::Optional)),
+               Presence::Optional)
           .key("motionPlaneNormal",
                Schema::realVector(3, "nonzero: unclamped nodes move perpendicular to it only (a one-cell-thick 2D "
                                      "scene gives its thickness axis, e.g. [0, 0, 1])",
@@ -352,6 +361,15 @@ MembraneBoundarySpec readBoundary(const SceneConfig& b, const std::vector<std::s
     checkSet(c, "nodes", sp.nodeSet, known);
     s.springs.push_back(sp);
   }
+  for (std::size_t i = 0; i < b.size("clampMotion"); ++i) {
+    const SceneConfig c = b.child("clampMotion." + std::to_string(i));
+    MembraneClampMotion m{c.get<std::string>("nodes"), c.get<std::array<double, 3>>("translation"),
+                          readTime(c.child("time"))};
+    checkSet(c, "nodes", m.nodeSet, known);
+    for (const auto& other : s.clampMotion)
+      if (other.nodeSet == m.nodeSet) throw InputError(c.where("nodes"), "'" + m.nodeSet + "' moves twice");
+    s.clampMotion.push_back(m);
+  }
   for (std::size_t i = 0; i < b.size("edgeBeams"); ++i) {
     const SceneConfig c = b.child("edgeBeams." + std::to_string(i));
     MembraneSetBeams bm{c.get<std::string>("nodes"), c.get<double>("axialStiffness"), c.get<bool>("tensionOnly")};
@@ -495,7 +513,32 @@ MembraneMeshInput generateMembraneMesh(const MembraneMeshSpec& spec) {
 
 MembraneBoundary resolveMembraneBoundary(const MembraneBoundarySpec& spec, const MembraneMesh& mesh) {
   MembraneBoundary b;
-  for (const auto& s : spec.clamp) b.clamps.push_back({mesh.nodeSet(s), {}, {}});
+  // Moving clamps first; their nodes leave the fixed sets (a node has one target).
+  std::set<lid_t> moving;
+  for (const auto& m : spec.clampMotion) {
+    const std::vector<lid_t>& nodes = mesh.nodeSet(m.nodeSet);
+    for (lid_t n : nodes)
+      if (!moving.insert(n).second)
+        throw InputError("membrane boundary.clampMotion: node " + std::to_string(n) + " is in two moving sets ('" +
+                         m.nodeSet + "' and another)");
+    const MembraneTimeFunction f = m.time;
+    const std::array<real, 3> d = m.translation;
+    b.clamps.push_back({nodes, {}, [f, d](real t) {
+                          RigidPlacement p;
+                          const real s = f(t);
+                          for (int k = 0; k < 3; ++k) p.placed[k] = s * d[k];
+                          return p;
+                        }});
+  }
+  for (const auto& s : spec.clamp) {
+    if (std::any_of(spec.clampMotion.begin(), spec.clampMotion.end(),
+                    [&](const MembraneClampMotion& m) { return m.nodeSet == s; }))
+      continue;
+    std::vector<lid_t> fixed;
+    for (lid_t n : mesh.nodeSet(s))
+      if (!moving.count(n)) fixed.push_back(n);
+    b.clamps.push_back({fixed, {}, {}});
+  }
   b.motionPlaneNormal = spec.motionPlaneNormal;
   for (const auto& s : spec.constrainToNormal) {
     const auto& nodes = mesh.nodeSet(s);

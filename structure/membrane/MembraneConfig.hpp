@@ -83,8 +83,16 @@ struct MembraneSetBeams {
 };
 
 /// \brief Boundary conditions by node-set name (resolved against the mesh by resolveMembraneBoundary).
+/// \brief A clamped node set that moves: each node to X + translation f(t).
+struct MembraneClampMotion {
+  std::string nodeSet;
+  std::array<real, 3> translation{0, 0, 0};  ///< m, at f = 1
+  MembraneTimeFunction time;                 ///< f(t) (constant 1 by default)
+};
+
 struct MembraneBoundarySpec {
   std::vector<std::string> clamp{"boundary"};
+  std::vector<MembraneClampMotion> clampMotion;
   std::vector<std::string> constrainToNormal;
   std::vector<MembraneSetSprings> springs;
   std::vector<MembraneSetBeams> edgeBeams;
