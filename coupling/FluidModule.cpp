@@ -40,6 +40,49 @@ double pressureAt(const FluidSolver& fluid, const Vec3& x, const std::string& pa
   return p(nearestCell(C, x));
 }
 
+// The same on a decomposed mesh (every rank calls it): the nearest owned cell of every rank, the
+// nearest of those (the lowest rank on a tie) giving the value; on a patch, each rank's two nearest
+// faces of owned cells, the two nearest of all ranks blended.
+double distributedPressureAt(const FluidSolver& fluid, const Vec3& x, const std::string& patch, MPI_Comm comm) {
+  const HexMesh& mesh = fluid.mesh();
+  int rank = 0, size = 1;
+  MPI_Comm_rank(comm, &rank);
+  MPI_Comm_size(comm, &size);
+  if (patch.empty()) {
+    auto C = Kokkos::create_mirror_view_and_copy(HostSpace(), fluid.geometry().cellCentroid);
+    auto p = Kokkos::create_mirror_view_and_copy(HostSpace(), fluid.pressure());
+    double d2 = 1e300;
+    const int c = mesh.nOwnedCells() > 0 ? nearestCell(C, x, mesh.nOwnedCells(), &d2) : -1;
+    struct {
+      double d;
+      int rank;
+    } mine{d2, rank}, best{0, 0};
+    MPI_Allreduce(&mine, &best, 1, MPI_DOUBLE_INT, MPI_MINLOC, comm);
+    double v = best.rank == rank && c >= 0 ? p(c) : 0.0, sum = 0;
+    MPI_Allreduce(&v, &sum, 1, MPI_DOUBLE, MPI_SUM, comm);
+    return sum;
+  }
+  const auto& pt = mesh.patches()[mesh.patchIndex(patch)];
+  auto fc = Kokkos::create_mirror_view_and_copy(HostSpace(), fluid.geometry().faceCentroid);
+  auto pb = Kokkos::create_mirror_view_and_copy(HostSpace(), fluid.boundaryPressure());
+  auto own = Kokkos::create_mirror_view_and_copy(HostSpace(), mesh.faceOwner());
+  const lid_t nIn = mesh.nInternalFaces();
+  TwoNearest near;  // this rank's two nearest faces of owned cells
+  for (lid_t f = pt.start; f < pt.start + pt.size; ++f) {
+    if (own(f) >= mesh.nOwnedCells()) continue;  // a ghost's face is its owner's
+    const double d = std::sqrt((fc(f, 0) - x[0]) * (fc(f, 0) - x[0]) + (fc(f, 1) - x[1]) * (fc(f, 1) - x[1]) +
+                               (fc(f, 2) - x[2]) * (fc(f, 2) - x[2]));
+    near.offer(d, pb(f - nIn));
+  }
+  const double mine[4] = {near.d1, near.v1, near.d2, near.v2};
+  std::vector<double> all(4 * static_cast<std::size_t>(size));
+  MPI_Allgather(mine, 4, MPI_DOUBLE, all.data(), 4, MPI_DOUBLE, comm);
+  TwoNearest global;
+  for (std::size_t i = 0; i < all.size(); i += 2) global.offer(all[i], all[i + 1]);  // rank order breaks ties
+  MFSI_CHECK(!global.empty(), "fluid: pressure at a point: patch '" << patch << "' has no faces");
+  return global.blend();
+}
+
 double dot(const Vec3& a, const Vec3& b) { return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]; }
 
 }  // namespace
@@ -52,8 +95,6 @@ FluidModule::FluidModule(const HexMesh& mesh, const FluidOptions& options, Fluid
       runaway_(solver_, options.divergenceVelocityFactor) {
   if (options.means.enabled) means_.emplace(mesh.nCells(), options.means);
   if (domain.distributed()) {
-    if (!reports_.pressureDifferences.empty())
-      throw InputError("fluid.pressureDifferences: not yet on several ranks (run the scene on one rank)");
     if (reports_.ghia.enabled) throw InputError("fluid.ghiaCheck: not yet on several ranks (run the scene on one rank)");
     comm_ = domain.comm;
     auto gid = Kokkos::create_mirror_view_and_copy(HostSpace(), mesh.cellGlobalIds());
@@ -195,8 +236,12 @@ void FluidModule::appendStepValues(std::vector<double>& v) const {
       v.push_back(dot(L.force, f.liftDirection) / q);
     }
   }
-  for (const auto& p : reports_.pressureDifferences)
-    v.push_back(pressureAt(solver_, p.from, p.patch) - pressureAt(solver_, p.to, p.patch));
+  for (const auto& p : reports_.pressureDifferences) v.push_back(pressureDifference(p.from, p.to, p.patch));
+}
+
+double FluidModule::pressureDifference(const Vec3& from, const Vec3& to, const std::string& patch) const {
+  if (comm_ == MPI_COMM_NULL) return pressureAt(solver_, from, patch) - pressureAt(solver_, to, patch);
+  return distributedPressureAt(solver_, from, patch, comm_) - distributedPressureAt(solver_, to, patch, comm_);
 }
 
 void FluidModule::addOutputFields(io::FieldFrame& frame) {
@@ -257,8 +302,7 @@ void FluidModule::addMetrics(std::map<std::string, double>& m) const {
       m[k + "c_L"] = dot(L.force, f.liftDirection) / q;
     }
   }
-  for (const auto& p : reports_.pressureDifferences)
-    m["fluid." + p.name] = pressureAt(solver_, p.from, p.patch) - pressureAt(solver_, p.to, p.patch);
+  for (const auto& p : reports_.pressureDifferences) m["fluid." + p.name] = pressureDifference(p.from, p.to, p.patch);
   if (reports_.ghia.enabled) {
     const GhiaErrors e = ghiaErrors(solver_, reports_.ghia.re, reports_.ghia.lidSpeed);
     m["fluid.ghia_u_max_err"] = e.uMax;

@@ -78,6 +78,8 @@ class FluidModule final : public Module {
   long long outerTotal_ = 0, pressureTotal_ = 0, momentumTotal_ = 0;
   /// A decomposed mesh: the ranks, the owned cells' global ids, the whole mesh's cell count, and
   /// the rank whose nearest cell holds each probe.
+  /// p(from) - p(to) (on `patch`'s faces when named), on any rank count (collective when decomposed).
+  double pressureDifference(const fluid::Vec3& from, const fluid::Vec3& to, const std::string& patch) const;
   MPI_Comm comm_ = MPI_COMM_NULL;
   std::vector<gid_t> ownedIds_;
   std::size_t globalCells_ = 0;

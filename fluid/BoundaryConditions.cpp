@@ -66,7 +66,12 @@ real shapeAt(const ResolvedPatch& rp, const real x[3]) {
 }  // namespace
 
 BoundaryConditions::BoundaryConditions(const HexMesh& mesh, const FluidOptions& opt, const SolverComm& comm)
-    : mesh_(&mesh), nIn_(mesh.nInternalFaces()) {
+    : mesh_(&mesh), comm_(comm), nIn_(mesh.nInternalFaces()), nOwned_(mesh.nOwnedCells()) {
+  {
+    auto own = Kokkos::create_mirror_view_and_copy(HostSpace(), mesh.faceOwner());
+    ghostFace_.resize(mesh.nFaces() - nIn_);
+    for (lid_t f = nIn_; f < mesh.nFaces(); ++f) ghostFace_[f - nIn_] = own(f) >= nOwned_;
+  }
   const auto& mp = mesh.patches();
   std::vector<const PatchBC*> given(mp.size(), nullptr);
   for (const auto& [name, bc] : opt.boundaries) {
@@ -134,12 +139,6 @@ BoundaryConditions::BoundaryConditions(const HexMesh& mesh, const FluidOptions& 
       MFSI_CHECK(tf.exponent > 0,
                  "fluid: patch '" << rp.name << "': half-power sine exponent must be positive, got " << tf.exponent);
     }
-    // A flow-rate inlet scales its profile by a sum over its faces, a resistance outlet its
-    // pressure by the flux summed over its faces: both sums would need the other ranks' faces.
-    MFSI_CHECK(mesh.nOwnedCells() == mesh.nCells() ||
-                   (rp.type != BoundaryType::FlowRate && rp.type != BoundaryType::Resistance),
-               "fluid: patch '" << rp.name << "': " << (rp.type == BoundaryType::FlowRate ? "flowRate" : "resistance")
-                                << " conditions do not run on several ranks yet");
     if (rp.type == BoundaryType::FixedPressure || rp.type == BoundaryType::Resistance) fixesPressure_ = true;
     // Bounding box of the patch nodes (reference configuration).
     rp.boxMin = {1e300, 1e300, 1e300};
@@ -235,12 +234,15 @@ void BoundaryConditions::update(const ExecSpace& exec, real t, const MeshGeometr
         break;
       case BoundaryType::FlowRate: {
         // Scale the shape so the discrete inflow sum_f u_f . S_f is exactly -Q(t).
+        // Over the faces of every rank (a ghost cell's face is its owner's).
         real sum = 0;
         for (lid_t f = rp.start; f < rp.start + rp.size; ++f) {
+          if (ghostFace_[f - nIn_]) continue;
           const real x[3] = {hFc(f, 0), hFc(f, 1), hFc(f, 2)};
           const real mag = std::sqrt(hSf(f, 0) * hSf(f, 0) + hSf(f, 1) * hSf(f, 1) + hSf(f, 2) * hSf(f, 2));
           sum += shapeAt(rp, x) * mag;
         }
+        sum = comm_.globalSum(sum);
         MFSI_CHECK(sum > 0, "fluid: flow-rate patch '" << rp.name << "' has zero profile area");
         const real scale = rp.bc.flowRate * ft / sum;
         for (lid_t f = rp.start; f < rp.start + rp.size; ++f) {
@@ -286,10 +288,15 @@ void BoundaryConditions::updateResistance(const ExecSpace& exec, const ConstReal
   for (auto& rp : patches_) {
     if (rp.type != BoundaryType::Resistance || !rp.open) continue;
     real q = 0;
-    const lid_t start = rp.start;
+    const lid_t start = rp.start, nOwned = nOwned_;
+    auto own = mesh_->faceOwner();
     Kokkos::parallel_reduce(
         "mfsi::fluid::bc::resistanceFlowRate", RangePolicy(exec, 0, rp.size),
-        KOKKOS_LAMBDA(lid_t i, real & acc) { acc += phi(start + i); }, q);
+        KOKKOS_LAMBDA(lid_t i, real & acc) {
+          if (own(start + i) < nOwned) acc += phi(start + i);  // a ghost's face is its owner's
+        },
+        q);
+    q = comm_.globalSum(q);
     rp.currentFlowRate = q;
     rp.currentPressure = rp.bc.resistance * q + rp.bc.timeFunction(time_) * rp.bc.pressure;
     Kokkos::deep_copy(exec, Kokkos::subview(pressure_, Kokkos::make_pair(start - nIn_, start - nIn_ + rp.size)),

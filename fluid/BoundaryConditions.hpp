@@ -77,7 +77,10 @@ class BoundaryConditions {
 
  private:
   const HexMesh* mesh_ = nullptr;
+  SolverComm comm_;  ///< sums over a patch span the ranks
   lid_t nIn_ = 0;
+  lid_t nOwned_ = 0;  ///< a boundary face of a ghost cell is its owner rank's: left out of the sums
+  std::vector<bool> ghostFace_;  ///< per boundary face: its owner cell is a ghost
   real time_ = 0;
   bool fixesPressure_ = false;
   bool hasValves_ = false;

@@ -120,23 +120,13 @@ real boundaryPressureAt(const FluidSolver& fluid, const std::string& patch, cons
   auto fc = Kokkos::create_mirror_view_and_copy(HostSpace(), fluid.geometry().faceCentroid);
   auto pb = Kokkos::create_mirror_view_and_copy(HostSpace(), fluid.boundaryPressure());
   const lid_t nIn = mesh.nInternalFaces();
-  lid_t f1 = -1, f2 = -1;
-  double d1 = 1e300, d2 = 1e300;
+  TwoNearest near;
   for (lid_t f = pt.start; f < pt.start + pt.size; ++f) {
     const double d = std::sqrt((fc(f, 0) - x[0]) * (fc(f, 0) - x[0]) + (fc(f, 1) - x[1]) * (fc(f, 1) - x[1]) +
                                (fc(f, 2) - x[2]) * (fc(f, 2) - x[2]));
-    if (d < d1) {
-      f2 = f1;
-      d2 = d1;
-      f1 = f;
-      d1 = d;
-    } else if (d < d2) {
-      f2 = f;
-      d2 = d;
-    }
+    near.offer(d, pb(f - nIn));
   }
-  if (f2 < 0 || d1 < 1e-12) return pb(f1 - nIn);
-  return (pb(f1 - nIn) / d1 + pb(f2 - nIn) / d2) / (1 / d1 + 1 / d2);
+  return near.blend();
 }
 
 }  // namespace mfsi::fluid

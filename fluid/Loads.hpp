@@ -39,4 +39,24 @@ void baffleNetPressure(const FluidSolver& fluid, const std::string& baffle, cons
 /// centroids are nearest, blended by inverse distance (the value of a face whose centroid is at `x`).
 real boundaryPressureAt(const FluidSolver& fluid, const std::string& patch, const Vec3& x);
 
+/// \brief The two nearest of a stream of (distance, value) candidates (the first one offered wins
+/// a tie), and their inverse-distance blend: what boundaryPressureAt takes from a patch's faces.
+struct TwoNearest {
+  double d1 = 1e300, v1 = 0, d2 = 1e300, v2 = 0;
+  void offer(double d, double v) {
+    if (d < d1) {
+      d2 = d1;
+      v2 = v1;
+      d1 = d;
+      v1 = v;
+    } else if (d < d2) {
+      d2 = d;
+      v2 = v;
+    }
+  }
+  bool empty() const { return !(d1 < 1e300); }
+  /// The blend (the nearest value alone when there is one candidate or it sits at the point).
+  double blend() const { return (!(d2 < 1e300) || d1 < 1e-12) ? v1 : (v1 / d1 + v2 / d2) / (1 / d1 + 1 / d2); }
+};
+
 }  // namespace mfsi::fluid

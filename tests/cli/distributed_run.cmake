@@ -25,6 +25,15 @@ function(last_row dir out)
   set(${out}_values "${last}" PARENT_SCOPE)
 endfunction()
 last_row(${WORK}/r1 one)
+# same_value(<a> <b> <what>): |a - b| <= 1e-10 |a| with |a| > 1e-6 (CMake's math is integer: awk
+# compares the reals).
+function(same_value a b what)
+  execute_process(COMMAND awk "BEGIN { d = ${a} - (${b}); if (d < 0) d = -d; a = ${a}; if (a < 0) a = -a; exit !(d <= 1e-10 * a && a > 1e-6) }"
+    RESULT_VARIABLE same)
+  if(NOT same EQUAL 0)
+    message(SEND_ERROR "${what}: ${b}, one rank ${a}")
+  endif()
+endfunction()
 
 foreach(np 2 3)
   execute_process(COMMAND ${MPIEXEC} --allow-run-as-root --oversubscribe -np ${np} ${MFSI} run ${scene}
@@ -46,12 +55,7 @@ foreach(np 2 3)
   foreach(key fluid.max_velocity fluid.lid.force_x fluid.lid.force_y)
     string(JSON a GET "${s1}" metrics ${key})
     string(JSON b GET "${s}" metrics ${key})
-    # |a - b| <= 1e-10 |a| (CMake's math is integer: awk compares the reals).
-    execute_process(COMMAND awk "BEGIN { d = ${a} - (${b}); if (d < 0) d = -d; a = ${a}; if (a < 0) a = -a; exit !(d <= 1e-10 * a && a > 1e-6) }"
-      RESULT_VARIABLE same)
-    if(NOT same EQUAL 0)
-      message(SEND_ERROR "${np} ranks: ${key} = ${b}, one rank ${a}")
-    endif()
+    same_value(${a} ${b} "${np} ranks: ${key}")
   endforeach()
   last_row(${WORK}/r${np} many)
   if(NOT many_header STREQUAL one_header)
@@ -60,11 +64,7 @@ foreach(np 2 3)
   list(FIND one_header fluid.probe.centre.Ux col)
   list(GET one_values ${col} a)
   list(GET many_values ${col} b)
-  execute_process(COMMAND awk "BEGIN { d = ${a} - (${b}); if (d < 0) d = -d; a = ${a}; if (a < 0) a = -a; exit !(d <= 1e-10 * a && a > 1e-6) }"
-    RESULT_VARIABLE same)
-  if(NOT same EQUAL 0)
-    message(SEND_ERROR "${np} ranks: probe Ux ${b}, one rank ${a}")
-  endif()
+  same_value(${a} ${b} "${np} ranks: probe Ux")
   file(GLOB frames ${WORK}/r${np}/fields/*.h5)
   list(LENGTH frames nf)
   file(GLOB frames1 ${WORK}/r1/fields/*.h5)
@@ -90,3 +90,24 @@ string(JSON ranks GET "${s}" ranks)
 if(NOT status STREQUAL "diverged" OR NOT ranks EQUAL 2)
   message(SEND_ERROR "diverging cavity on 2 ranks: summary status ${status}, ranks ${ranks}")
 endif()
+
+# Patch sums across ranks: a pulsed flow-rate inlet (its profile scaled by its area on all ranks),
+# two valved resistance outlets (p = C_r q + p0, q summed over all ranks' faces) and two pressure
+# differences (between cells, and between faces of a wall patch) give the
+# one-rank answer on 2 ranks to 1e-10.
+set(scene ${DATA}/distributed_resistance.yaml)
+execute_process(COMMAND ${MFSI} run ${scene} --out ${WORK}/q1 RESULT_VARIABLE rc1 OUTPUT_QUIET ERROR_VARIABLE e1)
+execute_process(COMMAND ${MPIEXEC} --allow-run-as-root --oversubscribe -np 2 ${MFSI} run ${scene}
+  --out ${WORK}/q2 RESULT_VARIABLE rc2 OUTPUT_QUIET ERROR_VARIABLE e2)
+if(NOT rc1 EQUAL 0 OR NOT rc2 EQUAL 0)
+  message(FATAL_ERROR "resistance channel: exit ${rc1} on one rank, ${rc2} on two\n${e1}\n${e2}")
+endif()
+last_row(${WORK}/q1 one)
+last_row(${WORK}/q2 many)
+foreach(key fluid.probe.centre fluid.probe.centre.Ux fluid.dpAxis fluid.dpWall)
+  list(FIND one_header ${key} col)
+  list(GET one_values ${col} a)
+  list(GET many_values ${col} b)
+  same_value(${a} ${b} "resistance channel on 2 ranks: ${key}")
+  message(STATUS "resistance channel: ${key} ${b} on 2 ranks, ${a} on one")
+endforeach()
