@@ -1,6 +1,7 @@
 #include "coupling/motion/ParentFrames.hpp"
 
 #include "core/Error.hpp"
+#include "core/HexGeometry.hpp"
 #include "kernels/Blas.hpp"
 
 #include <algorithm>
@@ -112,6 +113,47 @@ void ParentFrames::positions(const ExecSpace& exec, const ConstReal3View& refere
         real y[3];
         placedNode(W, F, nb, i, reference, relative, y);
         for (int k = 0; k < 3; ++k) x(i, k) = y[k];
+      });
+}
+
+void ParentFrames::setAccelerations(const std::vector<BodyAcceleration>& accelerations) {
+  MFSI_CHECK(static_cast<int>(accelerations.size()) == nBodies_, "parent frames: one acceleration per body expected");
+  if (accelerations_.extent(0) != static_cast<std::size_t>(nBodies_))
+    accelerations_ = Kokkos::View<double* [12], MemSpace>("mfsi::coupling::parentFrames::accelerations", nBodies_);
+  auto h = Kokkos::create_mirror_view(accelerations_);
+  for (int b = 0; b < nBodies_; ++b)
+    for (int k = 0; k < 3; ++k) {
+      h(b, k) = accelerations[b].centre[k];
+      h(b, 3 + k) = accelerations[b].acceleration[k];
+      h(b, 6 + k) = accelerations[b].omega[k];
+      h(b, 9 + k) = accelerations[b].alpha[k];
+    }
+  Kokkos::deep_copy(accelerations_, h);
+}
+
+void ParentFrames::inertialForce(const ExecSpace& exec, const ConstReal3View& x, const ConstRealView& mass,
+                                 const Real3View& f) const {
+  MFSI_CHECK(accelerations_.extent(0) == static_cast<std::size_t>(nBodies_),
+             "parent frames: inertialForce before setAccelerations");
+  const auto W = weights_;
+  const auto A = accelerations_;
+  const int nb = nBodies_;
+  Kokkos::parallel_for(
+      "mfsi::coupling::parentFrames::inertialForce", RangePolicy(exec, 0, static_cast<lid_t>(weights_.extent(0))),
+      KOKKOS_LAMBDA(lid_t i) {
+        real acc[3] = {0, 0, 0};
+        for (int b = 0; b < nb; ++b) {
+          const real w = W(i, b);
+          if (w == 0) continue;
+          const real r[3] = {x(i, 0) - A(b, 0), x(i, 1) - A(b, 1), x(i, 2) - A(b, 2)};
+          const real o[3] = {A(b, 6), A(b, 7), A(b, 8)}, al[3] = {A(b, 9), A(b, 10), A(b, 11)};
+          real oxr[3], axr[3], ooxr[3];  // omega x r, alpha x r, omega x (omega x r)
+          geom::cross(o, r, oxr);
+          geom::cross(al, r, axr);
+          geom::cross(o, oxr, ooxr);
+          for (int k = 0; k < 3; ++k) acc[k] += w * (A(b, 3 + k) + axr[k] + ooxr[k]);
+        }
+        for (int k = 0; k < 3; ++k) f(i, k) = -mass(i) * acc[k];
       });
 }
 

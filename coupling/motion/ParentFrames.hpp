@@ -13,9 +13,10 @@
 /// where that body puts the frame's own nodes, so frame and membrane never gap or overlap, and the
 /// blend keeps a membrane spanning two independently moving bodies continuous (nearest-body
 /// frames would tear it where the nearest body changes). The fluid's load on a mounted membrane is
-/// passed on to its parents, each element's share by its nodes' weights (the membrane's own
-/// inertia is not); nodal forces (the viscous traction) likewise, each node's by its weights, and
-/// they reach the frame-relative FEM rotated into the frames (sum_b w_b Q_b^T f).
+/// passed on to its parents, each element's share by its nodes' weights; nodal forces (the viscous
+/// traction, the inertia of the membrane's mass carried by the accelerating frames) likewise, each
+/// node's by its weights, and they reach the frame-relative FEM rotated into the frames
+/// (sum_b w_b Q_b^T f).
 #include "core/Types.hpp"
 #include "coupling/motion/BodyPatchMotion.hpp"
 
@@ -50,6 +51,20 @@ class ParentFrames {
   void positions(const ExecSpace& exec, const ConstReal3View& reference, const ConstRealView& relative,
                  const Real3View& x) const;
 
+  /// \brief The bodies' accelerations (one per slot, world axes): the centre of mass's c, its
+  /// acceleration a, the angular velocity omega and the angular acceleration alpha.
+  struct BodyAcceleration {
+    std::array<double, 3> centre{0, 0, 0}, acceleration{0, 0, 0}, omega{0, 0, 0}, alpha{0, 0, 0};
+  };
+  void setAccelerations(const std::vector<BodyAcceleration>& accelerations);
+  /// f(i) = -m_i sum_b w_ib (a_b + alpha_b x r + omega_b x (omega_b x r)), r = x_i - c_b: the
+  /// inertial force of node i (lumped mass m_i, position x_i) carried along by its frames. The
+  /// FEM, solved relative to the frames, takes it as a load (the frame's acceleration in its
+  /// inertia; the Coriolis term 2 omega x du/dt is left out), and the bodies take it back as the
+  /// membrane's inertia on them.
+  void inertialForce(const ExecSpace& exec, const ConstReal3View& x, const ConstRealView& mass,
+                     const Real3View& f) const;
+
   /// relative(i) = sum_b w_ib Q_b^T global(i): nodal forces into the frames the FEM is solved in.
   void toFrames(const ExecSpace& exec, const ConstReal3View& global, const Real3View& relative) const;
 
@@ -71,6 +86,7 @@ class ParentFrames {
   Kokkos::View<double**, MemSpace> weights_;  ///< node x body slot
   std::vector<double> hostWeights_;
   Kokkos::View<double* [15], MemSpace> frames_;  ///< per slot: c0 (3), c (3), Q row-major (9)
+  Kokkos::View<double* [12], MemSpace> accelerations_;  ///< per slot: c, a, omega, alpha
   int nBodies_ = 0;
 };
 

@@ -378,12 +378,42 @@ void FsiCoupling::setUpParents(const SceneConfig& section) {
     p.parents = coupling::ParentFrames(p.module->solver().mesh().hostPoints(), candidates, candidateBody,
                                        static_cast<int>(bodies_.size()));
     p.mounted = true;
-    if (options_.viscousTraction) {  // the FEM takes the viscous forces in its frames
+    if (options_.viscousTraction || p.dynamic) {  // the FEM takes the viscous forces and the inertia in its frames
       const lid_t n = p.module->solver().mesh().nNodes();
-      p.forceFrame = Real3View("mfsi::coupling::viscousForceInFrames", n);
+      p.forceFrame = Real3View("mfsi::coupling::nodeForceInFrames", n);
       p.nodePosition = Real3View("mfsi::coupling::mountedNodePosition", n);
       p.module->solver().loads().nodeForce = p.forceFrame;
     }
+    if (p.dynamic) {
+      const lid_t n = p.module->solver().mesh().nNodes();
+      p.inertia = Real3View("mfsi::coupling::frameInertia", n);
+      p.framePosition = Real3View("mfsi::coupling::framePosition", n);
+      p.nodeLoad = Real3View("mfsi::coupling::mountedNodeLoad", n);
+      // The membrane's mass rides on its bodies: each node's share by its weights joins the body
+      // (so a body's solve sees the mass it carries, and the FEM the frames' acceleration).
+      RigidBodySystem& sys = rigid_->system();
+      auto mass = Kokkos::create_mirror_view_and_copy(HostSpace(), p.module->solver().nodalMass());
+      const auto& X = p.module->solver().mesh().hostPoints();
+      for (std::size_t slot = 0; slot < bodies_.size(); ++slot) {
+        std::vector<double> m;
+        std::vector<Eigen::Vector3d> x;
+        for (lid_t i = 0; i < n; ++i) {
+          const double w = p.parents.weight(static_cast<std::size_t>(i), static_cast<int>(slot));
+          if (w == 0) continue;
+          m.push_back(w * mass(i));
+          x.emplace_back(X[i][0], X[i][1], X[i][2]);
+        }
+        if (!m.empty()) sys.addPointMasses(bodies_[slot].index, m, x);
+      }
+    }
+  }
+  // The bodies' centres of mass moved with the masses they took on.
+  const RigidBodySystem& sys = rigid_->system();
+  RigidTreeKinematics kin;
+  sys.model().kinematics(sys.time(), sys.q(), sys.qdot(), sys.qddot(), kin);
+  for (CoupledBody& b : bodies_) {
+    b.com0 = kin.bodies[b.index].com;
+    b.rotation0 = kin.bodies[b.index].frame.rotation;
   }
 }
 
@@ -473,6 +503,38 @@ void FsiCoupling::updateLoads(double scale, bool relax, double dt) {
   forceResidual_ = norm2 > 0 ? std::sqrt(change2 / norm2) : (change2 > 0 ? 1.0 : 0.0);
 }
 
+void FsiCoupling::updateFrameInertia() {
+  if (bodies_.empty()) return;
+  const RigidBodySystem& sys = rigid_->system();
+  std::vector<coupling::ParentFrames::BodyAcceleration> acc(bodies_.size());
+  for (std::size_t slot = 0; slot < bodies_.size(); ++slot) {
+    const RigidBodyReport r = sys.bodyReport(bodies_[slot].index);
+    for (int k = 0; k < 3; ++k) {
+      acc[slot].centre[k] = r.position[k];
+      acc[slot].acceleration[k] = r.acceleration[k];
+      acc[slot].omega[k] = r.angularVelocity[k];
+      acc[slot].alpha[k] = r.angularAcceleration[k];
+    }
+  }
+  for (Panel& p : panels_) {
+    if (p.inertia.extent(0) == 0) continue;
+    MembraneSolver& s = p.module->solver();
+    // At the step's start positions (the committed displacement): the rotational terms' lever.
+    p.parents.setAccelerations(acc);
+    p.parents.positions(exec_, s.mesh().referencePoints(), s.displacement(), p.framePosition);
+    p.parents.inertialForce(exec_, p.framePosition, s.nodalMass(), p.inertia);
+    Kokkos::deep_copy(exec_, p.nodeLoad, p.inertia);
+    if (options_.viscousTraction) {
+      const Real3View load = p.nodeLoad, viscous = p.force;
+      Kokkos::parallel_for(
+          "mfsi::coupling::mountedNodeLoad", RangePolicy(exec_, 0, s.mesh().nNodes()), KOKKOS_LAMBDA(lid_t i) {
+            for (int k = 0; k < 3; ++k) load(i, k) += viscous(i, k);
+          });
+    }
+    p.parents.toFrames(exec_, p.nodeLoad, p.forceFrame);
+  }
+}
+
 void FsiCoupling::updateBodyLoads(double scale) {
   if (bodies_.empty()) return;
   const fluid::FluidSolver& f = fluid_->solver();
@@ -523,6 +585,7 @@ void FsiCoupling::solveStructure(double t1, double dt) {
       throw DivergenceError(std::string("bodies: the rigid step to t = ") + std::to_string(t1) + " failed: " + e.what());
     }
   }
+  updateFrameInertia();  // the bodies' accelerations of this solve
   for (Panel& p : panels_) {
     MembraneSolver& s = p.module->solver();
     const MembraneSolveReport rep = p.dynamic ? s.solveStep(dt) : s.solveStatic(t1);

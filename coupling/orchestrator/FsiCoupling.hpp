@@ -121,6 +121,9 @@ class FsiCoupling final : public Module {
     Real3View force, forcePrevious;  ///< viscous nodal forces in use, and of the previous iteration
     Real3View forceFrame;    ///< mounted: `force` rotated into the frames (what its FEM receives)
     Real3View nodePosition;  ///< mounted: the nodes' current positions (the viscous forces' moments)
+    Real3View inertia;       ///< mounted, dynamic: the frames' acceleration on the nodes' masses (world axes)
+    Real3View framePosition;  ///< mounted, dynamic: the nodes' positions at the step's start (inertia's lever)
+    Real3View nodeLoad;      ///< mounted, dynamic: viscous force + inertia (world axes), before the frames
     Real3View faceVelocity;
     RealView iterate;  ///< this panel's slice of an interface iterate on the device (3 per node)
     Eigen::Index offset = 0;
@@ -147,6 +150,9 @@ class FsiCoupling final : public Module {
   void advanceLoadFilter();
   /// The fluid's force and moment on each coupled body's patches (times `scale`) become its external load.
   void updateBodyLoads(double scale);
+  /// Mounted dynamic membranes: the inertial force of their mass carried by the bodies' current
+  /// accelerations (Panel::inertia), and the FEM's nodal load in the frames (viscous + inertia).
+  void updateFrameInertia();
   void solveStructure(double t1, double dt);
   void gatherTrial(coupling::InterfaceVector& xt) const;
   /// The membranes (and bodies) to the iterate x; a membrane that closes a chamber first moves x

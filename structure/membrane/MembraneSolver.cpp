@@ -632,6 +632,19 @@ void MembraneSolver::commitStep() {
 
 void MembraneSolver::discardStep() { trial_ = {}; }
 
+RealView MembraneSolver::nodalMass() {
+  if (nodalMass_.extent(0) == static_cast<std::size_t>(mesh_.nNodes())) return nodalMass_;
+  const lid_t n = mesh_.nNodes();
+  RealView perDof("mfsi::structure::membrane::lumpedPerDof", 3 * n);
+  membraneMassItems(exec_, data_, nItems_, true, itemVec_);
+  gatherItemVectors(exec_, map_, itemVec_, perDof);
+  nodalMass_ = RealView("mfsi::structure::membrane::nodalMass", n);
+  auto m = nodalMass_;
+  Kokkos::parallel_for(
+      "mfsi::structure::membrane::nodalMass", RangePolicy(exec_, 0, n), KOKKOS_LAMBDA(lid_t i) { m(i) = perDof(3 * i); });
+  return nodalMass_;
+}
+
 void MembraneSolver::setInterfaceMass(real massPerArea) {
   MFSI_CHECK(std::isfinite(massPerArea) && massPerArea >= 0,
              "membrane: the interface mass must be finite and >= 0, got " << massPerArea);

@@ -129,6 +129,8 @@ class MembraneSolver {
   /// no longer answers a pressure change with the large move that only the fluid's added mass,
   /// which the partitioned structure solve does not see, would hold back.
   void setInterfaceMass(real massPerArea);
+  /// The lumped nodal masses rho h A_i [kg] (one per node; computed once).
+  RealView nodalMass();
   real interfaceMass() const { return interfaceMass_; }
 
   real time() const { return time_; }
@@ -253,6 +255,7 @@ class MembraneSolver {
   RealView lineStart_;  ///< the Newton iterate a time step's line search starts from
   real interfaceMass_ = 0;            ///< artificial added mass per area (setInterfaceMass)
   RealView interfaceNodeMass_, anchor_;  ///< its lumped nodal masses; the displacement a solve starts from
+  RealView nodalMass_;                   ///< nodalMass()
   RealView pElem_, pElemScaled_;  ///< element pressure in use (the load field, or a scaled copy)
   // Clamps: node ids, reference-frame targets at the requested time, start values of a load ramp.
   IndexView clampNodes_;

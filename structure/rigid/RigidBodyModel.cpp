@@ -176,4 +176,27 @@ void RigidBodyModel::equations(const RigidTreeKinematics& biasKin, const std::ve
   }
 }
 
+void RigidBodyModel::addPointMasses(int b, const std::vector<double>& m, const std::vector<Eigen::Vector3d>& p) {
+  MFSI_CHECK(b >= 0 && b < nBodies() && m.size() == p.size(), "rigid model: addPointMasses: bad arguments");
+  Body& body = bodies_[b];
+  double M = body.mass;
+  Eigen::Vector3d first = body.mass * body.com;
+  for (std::size_t i = 0; i < m.size(); ++i) {
+    MFSI_CHECK(std::isfinite(m[i]) && m[i] >= 0, "rigid model: a point mass must be finite and >= 0");
+    M += m[i];
+    first += m[i] * p[i];
+  }
+  if (!(M > 0)) return;
+  const Eigen::Vector3d c = first / M;
+  // Parallel axis: a mass at offset r from the new centre adds m (|r|^2 1 - r r^T).
+  auto shift = [](double mass, const Eigen::Vector3d& r) {
+    return mass * (r.squaredNorm() * Eigen::Matrix3d::Identity() - r * r.transpose());
+  };
+  Eigen::Matrix3d I = body.inertia + shift(body.mass, body.com - c);
+  for (std::size_t i = 0; i < m.size(); ++i) I += shift(m[i], p[i] - c);
+  body.mass = M;
+  body.com = c;
+  body.inertia = I;
+}
+
 }  // namespace mfsi

@@ -89,6 +89,10 @@ class RigidBodyModel {
   void equations(const RigidTreeKinematics& biasKin, const std::vector<RigidBodyLoad>& loads, Eigen::MatrixXd& M,
                  Eigen::VectorXd& Q) const;
 
+  /// \brief Point masses m_i at body-frame positions p_i join body b: its mass, centre of mass and
+  /// inertia about it become those of the union (a membrane carried by the body).
+  void addPointMasses(int b, const std::vector<double>& m, const std::vector<Eigen::Vector3d>& p);
+
   /// \brief Inertia tensor of body b about its CoM in world axes for the given kinematics.
   Eigen::Matrix3d worldInertia(const RigidTreeKinematics& kin, int b) const;
 

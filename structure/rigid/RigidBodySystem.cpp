@@ -90,6 +90,16 @@ RigidBodySystem::RigidBodySystem(const RigidSystemOptions& options)
   accelerationStale_ = true;
 }
 
+void RigidBodySystem::addPointMasses(int b, const std::vector<double>& m, const std::vector<Eigen::Vector3d>& x) {
+  const RigidFrameMotion& f = kin_.bodies[b].frame;
+  std::vector<Eigen::Vector3d> local(x.size());
+  for (std::size_t i = 0; i < x.size(); ++i) local[i] = f.rotation.transpose() * (x[i] - f.origin);
+  model_.addPointMasses(b, m, local);
+  model_.kinematics(state_.t, state_.q, state_.qdot, state_.qddot, kin_);
+  initialCom_[b] = kin_.bodies[b].com;
+  accelerationStale_ = true;
+}
+
 // --- loads and equations ----------------------------------------------------------------------
 
 void RigidBodySystem::bodyLoads(const RigidTreeKinematics& kin, std::vector<RigidBodyLoad>& loads) const {

@@ -98,6 +98,9 @@ class RigidBodySystem {
   int nBodies() const { return model_.nBodies(); }
   /// \brief Index of a body by name (throws InputError if unknown).
   int bodyIndex(const std::string& name) const { return model_.bodyIndex(name); }
+  /// \brief Point masses at world positions (the current pose) join body b (RigidBodyModel::
+  /// addPointMasses); before the first step.
+  void addPointMasses(int b, const std::vector<double>& m, const std::vector<Eigen::Vector3d>& worldPositions);
   /// \brief The kinematic tree.
   const RigidBodyModel& model() const { return model_; }
   /// \brief The options the system was built from.

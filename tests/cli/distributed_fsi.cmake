@@ -106,7 +106,7 @@ set(channel membrane-channel --set time.endTime=0.06 --set mesh.blocks.0.cells=[
 run(channel1 1 ${channel})
 run(channel2 2 ${channel})
 same(channel1 channel2 1e-9 fluid.bar.force_x bodies.body.frame.Fx fluid.max_velocity)
-same(channel1 channel2 1e-7 membrane.panelA.centreUz membrane.panelB.centreUz)
+same(channel1 channel2 1e-7 membrane.panelA.centreUx membrane.panelB.centreUx)
 
 set(balloon balloon --set time.endTime=2)
 run(balloon1 1 ${balloon} ${tight})
