@@ -8,6 +8,7 @@
 
 #include <cmath>
 #include <sstream>
+#include <type_traits>
 
 namespace mfsi {
 
@@ -95,7 +96,6 @@ FluidModule::FluidModule(const HexMesh& mesh, const FluidOptions& options, Fluid
       runaway_(solver_, options.divergenceVelocityFactor) {
   if (options.means.enabled) means_.emplace(mesh.nCells(), options.means);
   if (domain.distributed()) {
-    if (reports_.ghia.enabled) throw InputError("fluid.ghiaCheck: not yet on several ranks (run the scene on one rank)");
     comm_ = domain.comm;
     auto gid = Kokkos::create_mirror_view_and_copy(HostSpace(), mesh.cellGlobalIds());
     ownedIds_.assign(gid.data(), gid.data() + mesh.nOwnedCells());
@@ -239,6 +239,34 @@ void FluidModule::appendStepValues(std::vector<double>& v) const {
   for (const auto& p : reports_.pressureDifferences) v.push_back(pressureDifference(p.from, p.to, p.patch));
 }
 
+GhiaErrors FluidModule::ghiaCheck() const {
+  const int re = reports_.ghia.re;
+  const double lid = reports_.ghia.lidSpeed;
+  if (comm_ == MPI_COMM_NULL) return ghiaErrors(solver_, re, lid);
+  // Every rank's owned cells gathered on rank 0, which compares; the answer is broadcast.
+  const std::size_t n = ownedIds_.size();
+  const std::vector<double> c = gatherByGlobalId(comm_, 0, ownedIds_, io::hostValues(solver_.geometry().cellCentroid, n),
+                                                 3, globalCells_);
+  const std::vector<double> u = gatherByGlobalId(comm_, 0, ownedIds_, io::hostValues(solver_.velocity(), n), 3,
+                                                 globalCells_);
+  auto P = Kokkos::create_mirror_view_and_copy(HostSpace(), solver_.mesh().referencePoints());
+  double lo[2] = {1e300, 1e300}, hi[2] = {1e300, 1e300};  // hi negated: one MIN reduction for both
+  for (std::size_t i = 0; i < P.extent(0); ++i)
+    for (int d = 0; d < 2; ++d) {
+      lo[d] = std::min(lo[d], P(i, d));
+      hi[d] = std::min(hi[d], -P(i, d));
+    }
+  double ext[4] = {lo[0], lo[1], hi[0], hi[1]}, all[4];
+  MPI_Allreduce(ext, all, 4, MPI_DOUBLE, MPI_MIN, comm_);
+  int rank = 0;
+  MPI_Comm_rank(comm_, &rank);
+  GhiaErrors e;
+  if (rank == 0) e = ghiaErrors(c, u, {all[0], all[1]}, {-all[2], -all[3]}, re, lid);
+  static_assert(std::is_trivially_copyable_v<GhiaErrors>, "broadcast as bytes");
+  MPI_Bcast(&e, static_cast<int>(sizeof e), MPI_BYTE, 0, comm_);
+  return e;
+}
+
 double FluidModule::pressureDifference(const Vec3& from, const Vec3& to, const std::string& patch) const {
   if (comm_ == MPI_COMM_NULL) return pressureAt(solver_, from, patch) - pressureAt(solver_, to, patch);
   return distributedPressureAt(solver_, from, patch, comm_) - distributedPressureAt(solver_, to, patch, comm_);
@@ -304,7 +332,7 @@ void FluidModule::addMetrics(std::map<std::string, double>& m) const {
   }
   for (const auto& p : reports_.pressureDifferences) m["fluid." + p.name] = pressureDifference(p.from, p.to, p.patch);
   if (reports_.ghia.enabled) {
-    const GhiaErrors e = ghiaErrors(solver_, reports_.ghia.re, reports_.ghia.lidSpeed);
+    const GhiaErrors e = ghiaCheck();
     m["fluid.ghia_u_max_err"] = e.uMax;
     m["fluid.ghia_v_max_err"] = e.vMax;
     m["fluid.centreline_u_min"] = e.uLineMin;

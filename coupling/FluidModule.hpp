@@ -5,6 +5,7 @@
 #include "coupling/Module.hpp"
 #include "fluid/FluidConfig.hpp"
 #include "fluid/FluidSolver.hpp"
+#include "fluid/GhiaTable.hpp"
 #include "fluid/RunawayGuard.hpp"
 #include "fluid/RunningMean.hpp"
 
@@ -78,6 +79,8 @@ class FluidModule final : public Module {
   long long outerTotal_ = 0, pressureTotal_ = 0, momentumTotal_ = 0;
   /// A decomposed mesh: the ranks, the owned cells' global ids, the whole mesh's cell count, and
   /// the rank whose nearest cell holds each probe.
+  /// The Ghia comparison, on any rank count (collective when decomposed; every rank gets rank 0's).
+  fluid::GhiaErrors ghiaCheck() const;
   /// p(from) - p(to) (on `patch`'s faces when named), on any rank count (collective when decomposed).
   double pressureDifference(const fluid::Vec3& from, const fluid::Vec3& to, const std::string& patch) const;
   MPI_Comm comm_ = MPI_COMM_NULL;

@@ -83,17 +83,33 @@ const std::vector<GhiaPoint>& ghiaTable(int re) {
 }
 
 GhiaErrors ghiaErrors(const FluidSolver& fluid, int re, double lidSpeed) {
-  const auto& table = ghiaTable(re);
-  MFSI_CHECK(!table.empty(), "no Ghia table for Re = " << re);
-  auto C = Kokkos::create_mirror_view_and_copy(HostSpace(), fluid.geometry().cellCentroid);
-  auto U = Kokkos::create_mirror_view_and_copy(HostSpace(), fluid.velocity());
   auto P = Kokkos::create_mirror_view_and_copy(HostSpace(), fluid.mesh().referencePoints());
-  double lo[2] = {1e300, 1e300}, hi[2] = {-1e300, -1e300};
+  std::array<double, 2> lo{1e300, 1e300}, hi{-1e300, -1e300};
   for (int n = 0; n < static_cast<int>(P.extent(0)); ++n)
     for (int d = 0; d < 2; ++d) {
       lo[d] = std::min(lo[d], P(n, d));
       hi[d] = std::max(hi[d], P(n, d));
     }
+  auto C = Kokkos::create_mirror_view_and_copy(HostSpace(), fluid.geometry().cellCentroid);
+  auto U = Kokkos::create_mirror_view_and_copy(HostSpace(), fluid.velocity());
+  const std::size_t n = C.extent(0);
+  std::vector<double> c(3 * n), u(3 * n);
+  for (std::size_t i = 0; i < n; ++i)
+    for (int k = 0; k < 3; ++k) {
+      c[3 * i + k] = C(i, k);
+      u[3 * i + k] = U(i, k);
+    }
+  return ghiaErrors(c, u, lo, hi, re, lidSpeed);
+}
+
+GhiaErrors ghiaErrors(const std::vector<double>& centroids, const std::vector<double>& velocity,
+                      const std::array<double, 2>& lo, const std::array<double, 2>& hi, int re, double lidSpeed) {
+  const auto& table = ghiaTable(re);
+  MFSI_CHECK(!table.empty(), "no Ghia table for Re = " << re);
+  MFSI_CHECK(centroids.size() == velocity.size() && centroids.size() % 3 == 0, "Ghia comparison: bad field sizes");
+  const Kokkos::View<const double**, Kokkos::LayoutRight, HostSpace, Kokkos::MemoryTraits<Kokkos::Unmanaged>> C(
+      centroids.data(), centroids.size() / 3, 3),
+      U(velocity.data(), velocity.size() / 3, 3);
   const double Lx = hi[0] - lo[0], Ly = hi[1] - lo[1];
   const double tol = 1e-9 * std::max(Lx, Ly);
   // u on the vertical centreline vs y, v on the horizontal centreline vs x, both normalised.

@@ -5,6 +5,7 @@
 /// with them.
 #include "fluid/FluidSolver.hpp"
 
+#include <array>
 #include <vector>
 
 namespace mfsi::fluid {
@@ -41,5 +42,10 @@ struct GhiaErrors {
 /// linearly between the two cell columns (rows) next to the centreline, completed by the wall
 /// values, and evaluated at Ghia's points by cubic Lagrange interpolation.
 GhiaErrors ghiaErrors(const FluidSolver& fluid, int re, double lidSpeed);
+
+/// \brief The same from cell centroids and velocities (3 per cell, any order: the cells of every
+/// rank gathered) and the cavity's extent in x and y.
+GhiaErrors ghiaErrors(const std::vector<double>& centroids, const std::vector<double>& velocity,
+                      const std::array<double, 2>& lo, const std::array<double, 2>& hi, int re, double lidSpeed);
 
 }  // namespace mfsi::fluid
