@@ -63,18 +63,7 @@ double distributedPressureAt(const FluidSolver& fluid, const Vec3& x, const std:
     MPI_Allreduce(&v, &sum, 1, MPI_DOUBLE, MPI_SUM, comm);
     return sum;
   }
-  const auto& pt = mesh.patches()[mesh.patchIndex(patch)];
-  auto fc = Kokkos::create_mirror_view_and_copy(HostSpace(), fluid.geometry().faceCentroid);
-  auto pb = Kokkos::create_mirror_view_and_copy(HostSpace(), fluid.boundaryPressure());
-  auto own = Kokkos::create_mirror_view_and_copy(HostSpace(), mesh.faceOwner());
-  const lid_t nIn = mesh.nInternalFaces();
-  TwoNearest near;  // this rank's two nearest faces of owned cells
-  for (lid_t f = pt.start; f < pt.start + pt.size; ++f) {
-    if (own(f) >= mesh.nOwnedCells()) continue;  // a ghost's face is its owner's
-    const double d = std::sqrt((fc(f, 0) - x[0]) * (fc(f, 0) - x[0]) + (fc(f, 1) - x[1]) * (fc(f, 1) - x[1]) +
-                               (fc(f, 2) - x[2]) * (fc(f, 2) - x[2]));
-    near.offer(d, pb(f - nIn));
-  }
+  const TwoNearest near = nearestPatchFaces(fluid, patch, x);  // this rank's
   const double mine[4] = {near.d1, near.v1, near.d2, near.v2};
   std::vector<double> all(4 * static_cast<std::size_t>(size));
   MPI_Allgather(mine, 4, MPI_DOUBLE, all.data(), 4, MPI_DOUBLE, comm);
@@ -249,14 +238,9 @@ GhiaErrors FluidModule::ghiaCheck() const {
                                                  3, globalCells_);
   const std::vector<double> u = gatherByGlobalId(comm_, 0, ownedIds_, io::hostValues(solver_.velocity(), n), 3,
                                                  globalCells_);
-  auto P = Kokkos::create_mirror_view_and_copy(HostSpace(), solver_.mesh().referencePoints());
-  double lo[2] = {1e300, 1e300}, hi[2] = {1e300, 1e300};  // hi negated: one MIN reduction for both
-  for (std::size_t i = 0; i < P.extent(0); ++i)
-    for (int d = 0; d < 2; ++d) {
-      lo[d] = std::min(lo[d], P(i, d));
-      hi[d] = std::min(hi[d], -P(i, d));
-    }
-  double ext[4] = {lo[0], lo[1], hi[0], hi[1]}, all[4];
+  std::array<double, 2> lo, hi;
+  planeExtent(solver_.mesh(), lo, hi);
+  double ext[4] = {lo[0], lo[1], -hi[0], -hi[1]}, all[4];  // hi negated: one MIN reduction for both
   MPI_Allreduce(ext, all, 4, MPI_DOUBLE, MPI_MIN, comm_);
   int rank = 0;
   MPI_Comm_rank(comm_, &rank);

@@ -77,12 +77,12 @@ class FluidModule final : public Module {
   fluid::RunawayGuard runaway_;
   std::optional<fluid::RunningMean> means_;
   long long outerTotal_ = 0, pressureTotal_ = 0, momentumTotal_ = 0;
-  /// A decomposed mesh: the ranks, the owned cells' global ids, the whole mesh's cell count, and
-  /// the rank whose nearest cell holds each probe.
   /// The Ghia comparison, on any rank count (collective when decomposed; every rank gets rank 0's).
   fluid::GhiaErrors ghiaCheck() const;
   /// p(from) - p(to) (on `patch`'s faces when named), on any rank count (collective when decomposed).
   double pressureDifference(const fluid::Vec3& from, const fluid::Vec3& to, const std::string& patch) const;
+  /// A decomposed mesh: the ranks, the owned cells' global ids, the whole mesh's cell count, and
+  /// the rank whose nearest cell holds each probe.
   MPI_Comm comm_ = MPI_COMM_NULL;
   std::vector<gid_t> ownedIds_;
   std::size_t globalCells_ = 0;

@@ -82,14 +82,20 @@ const std::vector<GhiaPoint>& ghiaTable(int re) {
   return re == 100 ? kGhiaRe100 : none;
 }
 
-GhiaErrors ghiaErrors(const FluidSolver& fluid, int re, double lidSpeed) {
-  auto P = Kokkos::create_mirror_view_and_copy(HostSpace(), fluid.mesh().referencePoints());
-  std::array<double, 2> lo{1e300, 1e300}, hi{-1e300, -1e300};
+void planeExtent(const HexMesh& mesh, std::array<double, 2>& lo, std::array<double, 2>& hi) {
+  auto P = Kokkos::create_mirror_view_and_copy(HostSpace(), mesh.referencePoints());
+  lo = {1e300, 1e300};
+  hi = {-1e300, -1e300};
   for (int n = 0; n < static_cast<int>(P.extent(0)); ++n)
     for (int d = 0; d < 2; ++d) {
       lo[d] = std::min(lo[d], P(n, d));
       hi[d] = std::max(hi[d], P(n, d));
     }
+}
+
+GhiaErrors ghiaErrors(const FluidSolver& fluid, int re, double lidSpeed) {
+  std::array<double, 2> lo, hi;
+  planeExtent(fluid.mesh(), lo, hi);
   auto C = Kokkos::create_mirror_view_and_copy(HostSpace(), fluid.geometry().cellCentroid);
   auto U = Kokkos::create_mirror_view_and_copy(HostSpace(), fluid.velocity());
   const std::size_t n = C.extent(0);

@@ -43,6 +43,9 @@ struct GhiaErrors {
 /// values, and evaluated at Ghia's points by cubic Lagrange interpolation.
 GhiaErrors ghiaErrors(const FluidSolver& fluid, int re, double lidSpeed);
 
+/// \brief The x-y bounding box of the mesh's reference nodes (this rank's part of a decomposed one).
+void planeExtent(const HexMesh& mesh, std::array<double, 2>& lo, std::array<double, 2>& hi);
+
 /// \brief The same from cell centroids and velocities (3 per cell, any order: the cells of every
 /// rank gathered) and the cavity's extent in x and y.
 GhiaErrors ghiaErrors(const std::vector<double>& centroids, const std::vector<double>& velocity,

@@ -113,20 +113,28 @@ void baffleNetPressure(const FluidSolver& fluid, const std::string& baffle, cons
       KOKKOS_LAMBDA(lid_t i) { pNet(i) = pb(m0 + i) - pb(s0 + i); });
 }
 
-real boundaryPressureAt(const FluidSolver& fluid, const std::string& patch, const Vec3& x) {
+TwoNearest nearestPatchFaces(const FluidSolver& fluid, const std::string& patch, const Vec3& x) {
   const HexMesh& mesh = fluid.mesh();
   const auto& pt = mesh.patches()[mesh.patchIndex(patch)];
-  MFSI_CHECK(pt.size > 0, "fluid: boundaryPressureAt: patch '" << patch << "' has no faces");
   auto fc = Kokkos::create_mirror_view_and_copy(HostSpace(), fluid.geometry().faceCentroid);
   auto pb = Kokkos::create_mirror_view_and_copy(HostSpace(), fluid.boundaryPressure());
+  auto own = Kokkos::create_mirror_view_and_copy(HostSpace(), mesh.faceOwner());
   const lid_t nIn = mesh.nInternalFaces();
   TwoNearest near;
   for (lid_t f = pt.start; f < pt.start + pt.size; ++f) {
+    if (own(f) >= mesh.nOwnedCells()) continue;  // a ghost's face is its owner's
     const double d = std::sqrt((fc(f, 0) - x[0]) * (fc(f, 0) - x[0]) + (fc(f, 1) - x[1]) * (fc(f, 1) - x[1]) +
                                (fc(f, 2) - x[2]) * (fc(f, 2) - x[2]));
     near.offer(d, pb(f - nIn));
   }
-  return near.blend();
+  return near;
+}
+
+real boundaryPressureAt(const FluidSolver& fluid, const std::string& patch, const Vec3& x) {
+  const HexMesh& mesh = fluid.mesh();
+  MFSI_CHECK(mesh.patches()[mesh.patchIndex(patch)].size > 0,
+             "fluid: boundaryPressureAt: patch '" << patch << "' has no faces");
+  return nearestPatchFaces(fluid, patch, x).blend();
 }
 
 }  // namespace mfsi::fluid

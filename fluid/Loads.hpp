@@ -35,10 +35,6 @@ PatchLoads patchLoads(const FluidSolver& fluid, const std::string& name, const V
 /// pNet times the baffle normal (pointing from the master side to the slave side).
 void baffleNetPressure(const FluidSolver& fluid, const std::string& baffle, const RealView& pNet);
 
-/// \brief Pressure at point `x` on patch `patch`: the boundary values of the two faces whose
-/// centroids are nearest, blended by inverse distance (the value of a face whose centroid is at `x`).
-real boundaryPressureAt(const FluidSolver& fluid, const std::string& patch, const Vec3& x);
-
 /// \brief The two nearest of a stream of (distance, value) candidates (the first one offered wins
 /// a tie), and their inverse-distance blend: what boundaryPressureAt takes from a patch's faces.
 struct TwoNearest {
@@ -58,5 +54,13 @@ struct TwoNearest {
   /// The blend (the nearest value alone when there is one candidate or it sits at the point).
   double blend() const { return (!(d2 < 1e300) || d1 < 1e-12) ? v1 : (v1 / d1 + v2 / d2) / (1 / d1 + 1 / d2); }
 };
+
+/// \brief The two faces of `patch` nearest to x (by centroid) among this rank's owned cells' faces,
+/// with their boundary pressures: on one process, among all of them.
+TwoNearest nearestPatchFaces(const FluidSolver& fluid, const std::string& patch, const Vec3& x);
+
+/// \brief Pressure at point `x` on patch `patch`: the boundary values of the two faces whose
+/// centroids are nearest, blended by inverse distance (the value of a face whose centroid is at `x`).
+real boundaryPressureAt(const FluidSolver& fluid, const std::string& patch, const Vec3& x);
 
 }  // namespace mfsi::fluid

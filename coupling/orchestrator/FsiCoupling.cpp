@@ -378,17 +378,16 @@ void FsiCoupling::setUpParents(const SceneConfig& section) {
     p.parents = coupling::ParentFrames(p.module->solver().mesh().hostPoints(), candidates, candidateBody,
                                        static_cast<int>(bodies_.size()));
     p.mounted = true;
+    const lid_t n = p.module->solver().mesh().nNodes();
     if (options_.viscousTraction || p.dynamic) {  // the FEM takes the viscous forces and the inertia in its frames
-      const lid_t n = p.module->solver().mesh().nNodes();
       p.forceFrame = Real3View("mfsi::coupling::nodeForceInFrames", n);
-      p.nodePosition = Real3View("mfsi::coupling::mountedNodePosition", n);
       p.module->solver().loads().nodeForce = p.forceFrame;
     }
+    if (options_.viscousTraction) p.nodePosition = Real3View("mfsi::coupling::mountedNodePosition", n);
     if (p.dynamic) {
-      const lid_t n = p.module->solver().mesh().nNodes();
       p.inertia = Real3View("mfsi::coupling::frameInertia", n);
       p.framePosition = Real3View("mfsi::coupling::framePosition", n);
-      p.nodeLoad = Real3View("mfsi::coupling::mountedNodeLoad", n);
+      if (options_.viscousTraction) p.nodeLoad = Real3View("mfsi::coupling::mountedNodeLoad", n);
       // The membrane's mass rides on its bodies: each node's share by its weights joins the body
       // (so a body's solve sees the mass it carries, and the FEM the frames' acceleration).
       RigidBodySystem& sys = rigid_->system();
@@ -494,7 +493,9 @@ void FsiCoupling::updateLoads(double scale, bool relax, double dt) {
         "mfsi::coupling::forceRelaxation", RangePolicy(exec_, 0, p.iface.nNodes()), KOKKOS_LAMBDA(lid_t i) {
           for (int k = 0; k < 3; ++k) force(i, k) = w * force(i, k) + (1 - w) * fprev(i, k);
         });
-    if (p.mounted) p.parents.toFrames(exec_, p.force, p.forceFrame);
+    // A mounted dynamic membrane's FEM load also carries its inertia: updateFrameInertia rotates
+    // both before each structure solve.
+    if (p.mounted && !p.dynamic) p.parents.toFrames(exec_, p.force, p.forceFrame);
   }
   updateBodyLoads(scale);
   const SolverComm comm;
@@ -523,14 +524,15 @@ void FsiCoupling::updateFrameInertia() {
     p.parents.setAccelerations(acc);
     p.parents.positions(exec_, s.mesh().referencePoints(), s.displacement(), p.framePosition);
     p.parents.inertialForce(exec_, p.framePosition, s.nodalMass(), p.inertia);
-    Kokkos::deep_copy(exec_, p.nodeLoad, p.inertia);
-    if (options_.viscousTraction) {
-      const Real3View load = p.nodeLoad, viscous = p.force;
-      Kokkos::parallel_for(
-          "mfsi::coupling::mountedNodeLoad", RangePolicy(exec_, 0, s.mesh().nNodes()), KOKKOS_LAMBDA(lid_t i) {
-            for (int k = 0; k < 3; ++k) load(i, k) += viscous(i, k);
-          });
+    if (!options_.viscousTraction) {
+      p.parents.toFrames(exec_, p.inertia, p.forceFrame);
+      continue;
     }
+    const Real3View load = p.nodeLoad, inertia = p.inertia, viscous = p.force;
+    Kokkos::parallel_for(
+        "mfsi::coupling::mountedNodeLoad", RangePolicy(exec_, 0, s.mesh().nNodes()), KOKKOS_LAMBDA(lid_t i) {
+          for (int k = 0; k < 3; ++k) load(i, k) = inertia(i, k) + viscous(i, k);
+        });
     p.parents.toFrames(exec_, p.nodeLoad, p.forceFrame);
   }
 }

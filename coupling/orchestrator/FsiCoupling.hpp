@@ -123,7 +123,7 @@ class FsiCoupling final : public Module {
     Real3View nodePosition;  ///< mounted: the nodes' current positions (the viscous forces' moments)
     Real3View inertia;       ///< mounted, dynamic: the frames' acceleration on the nodes' masses (world axes)
     Real3View framePosition;  ///< mounted, dynamic: the nodes' positions at the step's start (inertia's lever)
-    Real3View nodeLoad;      ///< mounted, dynamic: viscous force + inertia (world axes), before the frames
+    Real3View nodeLoad;      ///< mounted, dynamic, viscous traction: viscous force + inertia (world axes)
     Real3View faceVelocity;
     RealView iterate;  ///< this panel's slice of an interface iterate on the device (3 per node)
     Eigen::Index offset = 0;

@@ -531,13 +531,10 @@ MembraneBoundary resolveMembraneBoundary(const MembraneBoundarySpec& spec, const
                         }});
   }
   for (const auto& s : spec.clamp) {
-    if (std::any_of(spec.clampMotion.begin(), spec.clampMotion.end(),
-                    [&](const MembraneClampMotion& m) { return m.nodeSet == s; }))
-      continue;
     std::vector<lid_t> fixed;
     for (lid_t n : mesh.nodeSet(s))
       if (!moving.count(n)) fixed.push_back(n);
-    b.clamps.push_back({fixed, {}, {}});
+    if (!fixed.empty()) b.clamps.push_back({fixed, {}, {}});
   }
   b.motionPlaneNormal = spec.motionPlaneNormal;
   for (const auto& s : spec.constrainToNormal) {

@@ -82,7 +82,6 @@ struct MembraneSetBeams {
   bool tensionOnly = false;
 };
 
-/// \brief Boundary conditions by node-set name (resolved against the mesh by resolveMembraneBoundary).
 /// \brief A clamped node set that moves: each node to X + translation f(t).
 struct MembraneClampMotion {
   std::string nodeSet;
@@ -90,6 +89,7 @@ struct MembraneClampMotion {
   MembraneTimeFunction time;                 ///< f(t) (constant 1 by default)
 };
 
+/// \brief Boundary conditions by node-set name (resolved against the mesh by resolveMembraneBoundary).
 struct MembraneBoundarySpec {
   std::vector<std::string> clamp{"boundary"};
   std::vector<MembraneClampMotion> clampMotion;

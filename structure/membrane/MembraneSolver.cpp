@@ -650,16 +650,18 @@ void MembraneSolver::setInterfaceMass(real massPerArea) {
              "membrane: the interface mass must be finite and >= 0, got " << massPerArea);
   interfaceMass_ = massPerArea;
   if (massPerArea == 0) return;
-  const lid_t n3 = 3 * mesh_.nNodes();
   MFSI_CHECK(options_.material.density > 0 && options_.material.thickness > 0,
              "membrane: an interface mass needs density and thickness > 0");
-  // The lumped mass rho h A_i per dof, scaled to massPerArea A_i.
+  // The nodal masses rho h A_i per dof, scaled to massPerArea A_i.
+  const lid_t n3 = 3 * mesh_.nNodes();
   interfaceNodeMass_ = RealView("mfsi::structure::membrane::interfaceNodeMass", n3);
   anchor_ = RealView("mfsi::structure::membrane::interfaceAnchor", n3);
-  membraneMassItems(exec_, data_, nItems_, true, itemVec_);
-  gatherItemVectors(exec_, map_, itemVec_, interfaceNodeMass_);
-  blas::axpby(exec_, n3, massPerArea / (options_.material.density * options_.material.thickness),
-              interfaceNodeMass_, 0.0, interfaceNodeMass_);
+  auto m = nodalMass();
+  auto mi = interfaceNodeMass_;
+  const real scale = massPerArea / (options_.material.density * options_.material.thickness);
+  Kokkos::parallel_for(
+      "mfsi::structure::membrane::interfaceNodeMass", RangePolicy(exec_, 0, n3),
+      KOKKOS_LAMBDA(lid_t i) { mi(i) = scale * m(i / 3); });
 }
 
 MembraneSolveReport MembraneSolver::step(real dt) {

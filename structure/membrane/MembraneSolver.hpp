@@ -254,8 +254,8 @@ class MembraneSolver {
   RealView volumeGrad_, volumeDu_;  ///< g and b of the constrained Newton step
   RealView lineStart_;  ///< the Newton iterate a time step's line search starts from
   real interfaceMass_ = 0;            ///< artificial added mass per area (setInterfaceMass)
-  RealView interfaceNodeMass_, anchor_;  ///< its lumped nodal masses; the displacement a solve starts from
-  RealView nodalMass_;                   ///< nodalMass()
+  RealView interfaceNodeMass_, anchor_;  ///< its nodal masses per dof; the displacement a solve starts from
+  RealView nodalMass_;                ///< nodalMass()
   RealView pElem_, pElemScaled_;  ///< element pressure in use (the load field, or a scaled copy)
   // Clamps: node ids, reference-frame targets at the requested time, start values of a load ramp.
   IndexView clampNodes_;
