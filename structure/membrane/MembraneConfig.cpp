@@ -98,7 +98,12 @@ Schema panelSchema() {
           .key("density", Schema::real("density rho (needed by dynamics)", "kg/m^3").atLeast(0),
                Default(o.material.density))
           .key("preStress", Schema::real("isotropic membrane pre-stress T0 (force per length)", "N/m"),
-               Default(o.material.preStress));
+               Default(o.material.preStress))
+          .key("bending",
+               Schema::choice("none: a membrane; plate: add rotation-free plate bending, D = E h^3 / (12 (1 - nu^2)) "
+                              "(hinges on the displacement dofs; quad meshes; rims simply supported)",
+                              {"none", "plate"}),
+               Default("none"));
   Schema solver =
       Schema::map("nonlinear solver of static solves (time steps always use consistent-tangent Newton)")
           .key("method",
@@ -392,6 +397,7 @@ MembranePanelOptions readPanel(const SceneConfig& p, std::size_t index, std::siz
   opt.material.thickness = p.get<double>("material.thickness");
   opt.material.density = p.get<double>("material.density");
   opt.material.preStress = p.get<double>("material.preStress");
+  opt.material.bending = p.get<std::string>("material.bending") == "plate";
   opt.wrinkling = p.get<std::string>("wrinkling") == "tensionField" ? MembraneWrinklingModel::TensionField
                                                                     : MembraneWrinklingModel::None;
   opt.wrinklingStiffnessFraction = p.get<double>("wrinklingStiffnessFraction");

@@ -17,7 +17,14 @@ struct MembraneMaterial {
   real thickness = 0;       ///< h (m)
   real density = 0;         ///< rho (kg/m^3); needed for dynamics only
   real preStress = 0;       ///< T0 (N/m): isotropic membrane force added to h S in the reference state
+  /// Plate bending on top of the membrane (MembraneBending.hpp), D = E h^3 / (12 (1 - nu^2)).
+  bool bending = false;
 };
+
+/// The plate bending stiffness D = E h^3 / (12 (1 - nu^2)) [N m] of the material.
+inline real plateBendingStiffness(const MembraneMaterial& m) {
+  return m.youngsModulus * m.thickness * m.thickness * m.thickness / (12 * (1 - m.poissonRatio * m.poissonRatio));
+}
 
 /// \brief Throws InputError for E <= 0, h <= 0, nu outside [0, 0.5], rho < 0.
 void validate(const MembraneMaterial& material);

@@ -125,6 +125,11 @@ void MembraneSolver::setupItems() {
   Kokkos::deep_copy(lines_.springStiffness, hsk);
   Kokkos::deep_copy(lines_.springRestLength, hsl);
 
+  if (options_.material.bending) {
+    hinges_ = buildMembraneHinges(mesh_, plateBendingStiffness(options_.material));
+    hingeItem0_ = static_cast<lid_t>(items.size());
+    items.insert(items.end(), hinges_.hostNodes.begin(), hinges_.hostNodes.end());
+  }
   nItems_ = static_cast<lid_t>(items.size());
   map_ = buildCsrAssemblyMap(items, nN, 3, "mfsi::structure::membrane::assembly");
   K_ = makeMatrix(map_, "mfsi::structure::membrane::tangent");
@@ -265,6 +270,7 @@ MembranePressureKernel MembraneSolver::pressureKernel(bool withStiffness) const 
 void MembraneSolver::evalResidual(const ConstRealView& u, real time, real loadFactor) {
   updatePressure(time, loadFactor);
   membraneResidualItems(exec_, data_, pressureKernel(false), lines_, u, itemVec_, itemExt_);
+  if (hinges_.size() > 0) membraneHingeResidualItems(exec_, hinges_, data_.X, u, hingeItem0_, itemVec_, itemExt_);
   gatherItemVectors(exec_, map_, itemVec_, R_);
   gatherItemVectors(exec_, map_, itemExt_, Fext_);
   if (loads_.nodeForce.extent(0) > 0) {
@@ -285,6 +291,7 @@ void MembraneSolver::evalResidual(const ConstRealView& u, real time, real loadFa
 
 void MembraneSolver::assembleTangentAt(const ConstRealView& u, bool withPressure) {
   membraneTangentItems(exec_, data_, pressureKernel(withPressure), lines_, u, itemMat_);
+  if (hinges_.size() > 0) membraneHingeTangentItems(exec_, hinges_, data_.X, u, hingeItem0_, false, itemMat_);
   gatherItemMatrices(exec_, map_, itemMat_, K_);
 }
 
@@ -540,6 +547,7 @@ MembraneSolveReport MembraneSolver::lumpedSolve(real time, real loadFactor) {
     }
     if (!std::isfinite(rel)) return rep;
     membraneLumpedStiffnessItems(exec_, data_, lines_, u_, itemVec_);
+    if (hinges_.size() > 0) membraneHingeTangentItems(exec_, hinges_, data_.X, u_, hingeItem0_, true, itemVec_);
     gatherItemVectors(exec_, map_, itemVec_, work_);
     auto D = work_;
     auto R = R_;
@@ -1040,6 +1048,7 @@ std::map<std::string, double> MembraneSolver::summary() {
   out["minPrincipalStress"] = minS2;
   out["wrinkledFraction"] = wr / mesh_.referenceArea();
   out["slackFraction"] = sl / mesh_.referenceArea();
+  if (hinges_.size() > 0) out["bendingEnergy"] = membraneBendingEnergy(exec_, hinges_, data_.X, u_);
   out["iterations"] = last_.iterations;
   out["linearIterations"] = last_.linearIterations;
   out["relativeResidual"] = last_.relativeResidual;

@@ -19,6 +19,7 @@
 ///
 /// State vectors are flat device Views with 3 entries per node (x, y, z).
 #include "core/io/Checkpoint.hpp"
+#include "structure/membrane/MembraneBending.hpp"
 #include "structure/membrane/MembraneElements.hpp"
 #include "structure/membrane/MembraneLinearSolve.hpp"
 
@@ -227,6 +228,8 @@ class MembraneSolver {
   MembraneReferenceGeometry geometry_;
   MembraneElementData data_;
   MembraneLineItems lines_;
+  MembraneHinges hinges_;  ///< bending (material.bending), item rows from hingeItem0_
+  lid_t hingeItem0_ = 0;
   CsrAssemblyMap map_;
   CsrMatrix K_, M_, Kdamp_;
   MembraneConstraints constraints_;
