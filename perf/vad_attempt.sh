@@ -5,6 +5,7 @@
 #
 #   perf/vad_attempt.sh              # ~1 min on 1 thread
 #   perf/vad_attempt.sh --set coupling.interfaceMass=5    # extra options go to mfsi run
+#   VAD_MESH_ARGS="--around 48 --ring 9" perf/vad_attempt.sh  # options of scripts/vad_mesh.py
 set -euo pipefail
 repo=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)
 mfsi=${MFSI:-$repo/build/apps/mfsi}
@@ -12,7 +13,8 @@ work=${WORK:-/tmp/mfsi-vad}
 py=/usr/bin/python3
 [ -x "$mfsi" ] || { echo "$mfsi not found: build the project first (or set MFSI=...)" >&2; exit 1; }
 mkdir -p "$work"
-$py "$repo/scripts/vad_mesh.py" --blood-only "$work/vad_blood.msh" > /dev/null
+# shellcheck disable=SC2086
+$py "$repo/scripts/vad_mesh.py" --blood-only ${VAD_MESH_ARGS:-} "$work/vad_blood.msh" > /dev/null
 cp "$repo/perf/scenes/vad_lumped.yaml" "$work/"
 export OMP_PROC_BIND=false
 "$mfsi" run "$work/vad_lumped.yaml" --out "$work/out" --overwrite --threads 1 "$@" > "$work/run.log" 2>&1 || true

@@ -212,6 +212,14 @@ Schema panelSchema() {
       .key("wrinklingStiffnessFraction",
            Schema::real("safeguard stiffness of the tension-field tangent", "-").atLeast(0),
            Default(o.wrinklingStiffnessFraction))
+      .key("wrinklingResidualStiffness",
+           Schema::real("fraction f of the elastic law a wrinkled or slack point keeps, in its stress too: "
+                        "N = (1 - f) N_tensionField + f h C E (0: the pure tension field; a slack sheet then has no "
+                        "in-plane stiffness and its nodes drift in its plane)",
+                        "-")
+               .atLeast(0)
+               .atMost(1),
+           Default(o.wrinklingResidualStiffness))
       .key("analysis",
            Schema::choice("static: equilibrium at the start and at the end of every step; dynamic: implicit dynamics",
                           {"static", "dynamic"}),
@@ -398,9 +406,14 @@ MembranePanelOptions readPanel(const SceneConfig& p, std::size_t index, std::siz
   opt.material.density = p.get<double>("material.density");
   opt.material.preStress = p.get<double>("material.preStress");
   opt.material.bending = p.get<std::string>("material.bending") == "plate";
+  if (opt.material.bending && p.child("mesh").has("rectangle") && p.child("mesh").child("rectangle").get<std::string>(
+                                                                        "elements") == "triangles")
+    throw InputError(p.where("material.bending"), "plate bending needs a quad membrane mesh (its hinge constants are "
+                                                  "calibrated for quads), and mesh.rectangle.elements is triangles");
   opt.wrinkling = p.get<std::string>("wrinkling") == "tensionField" ? MembraneWrinklingModel::TensionField
                                                                     : MembraneWrinklingModel::None;
   opt.wrinklingStiffnessFraction = p.get<double>("wrinklingStiffnessFraction");
+  opt.wrinklingResidualStiffness = p.get<double>("wrinklingResidualStiffness");
   opt.solver = p.get<std::string>("solver.method") == "lumped" ? MembraneStaticSolver::LumpedNewtonRaphson
                                                                : MembraneStaticSolver::Newton;
   opt.tolerance = p.get<double>("solver.tolerance");

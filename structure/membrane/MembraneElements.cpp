@@ -298,6 +298,7 @@ MembraneElementData makeMembraneElementData(const MembraneMesh& mesh, const Memb
   d.law.h = m.thickness;
   d.law.preStrain = m.preStress * (1 - m.poissonRatio) / (m.youngsModulus * m.thickness);
   d.law.eta = options.wrinklingStiffnessFraction;
+  d.law.residual = options.wrinklingResidualStiffness;
   d.law.wrinkling = options.wrinkling == MembraneWrinklingModel::TensionField;
   d.tangentFloor = options.newton.tangentStressFloor * m.youngsModulus * m.thickness;
   d.density = m.density * m.thickness;

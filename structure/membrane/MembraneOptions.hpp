@@ -109,6 +109,9 @@ struct MembraneOptions {
   MembraneWrinklingModel wrinkling = MembraneWrinklingModel::None;
   /// Safeguard stiffness fraction eta of the tension-field tangent (MembraneWrinkling.hpp).
   real wrinklingStiffnessFraction = 1e-3;
+  /// Fraction of the elastic law a wrinkled or slack point keeps, in the stress as well
+  /// (MembraneLaw::residual): 0 = the pure tension field.
+  real wrinklingResidualStiffness = 0;
   MembraneStaticSolver solver = MembraneStaticSolver::Newton;
   /// Convergence: ||R_free|| <= tolerance * max(||F_ext||, ||reactions||, ||R_free at the start||)
   /// (time steps: also ||inertia force||).

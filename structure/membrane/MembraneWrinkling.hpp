@@ -76,6 +76,10 @@ struct MembraneLaw {
   real E = 0, nu = 0, h = 0;
   real preStrain = 0;
   real eta = 1e-3;
+  /// Fraction f of the elastic law a wrinkled or slack point keeps: N = (1 - f) N_tf + f h C E
+  /// (continuous at both state boundaries, since N_tf = h C E where taut). 0: the pure tension
+  /// field. A slack sheet otherwise has no in-plane stiffness at all, so its nodes drift in its plane.
+  real residual = 0;
   bool wrinkling = false;  ///< tension-field model on
 
   KOKKOS_INLINE_FUNCTION MembraneWrinkleState evaluate(const real strain[3], real N[3], real Ct[3][3]) const {
@@ -83,6 +87,14 @@ struct MembraneLaw {
     MembraneWrinkleState state = MembraneWrinkleState::Taut;
     if (wrinkling) {
       state = membrane::tensionField(E, nu, eta, e, N, Ct);
+      if (residual > 0 && state != MembraneWrinkleState::Taut) {
+        real C[3][3];
+        planeStressMatrix(E, nu, C);
+        for (int i = 0; i < 3; ++i) {
+          N[i] = (1 - residual) * N[i] + residual * (C[i][0] * e[0] + C[i][1] * e[1] + C[i][2] * e[2]);
+          for (int j = 0; j < 3; ++j) Ct[i][j] = (1 - residual) * Ct[i][j] + residual * C[i][j];
+        }
+      }
     } else {
       planeStressMatrix(E, nu, Ct);
       for (int i = 0; i < 3; ++i) N[i] = Ct[i][0] * e[0] + Ct[i][1] * e[1] + Ct[i][2] * e[2];

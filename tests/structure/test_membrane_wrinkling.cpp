@@ -81,6 +81,55 @@ TEST(MembraneWrinkling, ConsistentTangentInEveryState) {
   }
 }
 
+TEST(MembraneWrinkling, ResidualStiffnessBlendsTheElasticLaw) {
+  // N = (1 - f) N_tf + f h C E in the wrinkled and slack states, the elastic law where taut: the
+  // slack point now resists (f h C E), the wrinkled one carries f of its compression, the stress
+  // stays continuous across the taut/wrinkled boundary and the tangent is the stress's derivative.
+  const double E = 1e6, nu = 0.3, h = 1e-3, f = 0.01;
+  membrane::MembraneLaw law;
+  law.E = E;
+  law.nu = nu;
+  law.h = h;
+  law.eta = 0;
+  law.wrinkling = true;
+  law.residual = f;
+  real C[3][3];
+  membrane::planeStressMatrix(E, nu, C);
+  const real points[4][3] = {{0.01, 0.005, 0.002}, {0.01, -0.006, 0.004}, {-0.01, -0.004, 0.001}, {0.01, -0.004, 0}};
+  for (const auto& e : points) {
+    real N[3], Ct[3][3], Sf[3], Cf[3][3];
+    const auto state = law.evaluate(e, N, Ct);
+    EXPECT_EQ(membrane::tensionField(E, nu, 0, e, Sf, Cf), state);
+    for (int i = 0; i < 3; ++i) {
+      const double elastic = C[i][0] * e[0] + C[i][1] * e[1] + C[i][2] * e[2];
+      const double expected = state == MembraneWrinkleState::Taut ? elastic : (1 - f) * Sf[i] + f * elastic;
+      EXPECT_TRUE(near(N[i], h * expected, Tol{1e-9, 1e-12}));
+    }
+    const double d = 1e-8;
+    for (int j = 0; j < 3; ++j) {
+      real ep[3] = {e[0], e[1], e[2]}, em[3] = {e[0], e[1], e[2]}, Np[3], Nm[3], Cd[3][3];
+      ep[j] += d;
+      em[j] -= d;
+      law.evaluate(ep, Np, Cd);
+      law.evaluate(em, Nm, Cd);
+      for (int i = 0; i < 3; ++i) EXPECT_TRUE(near(Ct[i][j], (Np[i] - Nm[i]) / (2 * d), Tol{1e-3 * E * h, 0}));
+    }
+  }
+  // The slack point resists: its stress is f times the elastic one, not zero.
+  real N[3], Ct[3][3];
+  const real slack[3] = {-0.01, -0.004, 0.001};
+  law.evaluate(slack, N, Ct);
+  EXPECT_TRUE(near(N[0], f * h * (C[0][0] * slack[0] + C[0][1] * slack[1]), Tol{0, 1e-12}));
+  EXPECT_LT(N[0], 0);
+  // Continuity at the taut/wrinkled boundary e2 = -nu e1.
+  const double e1 = 0.01;
+  real Na[3], Nb[3];
+  const real ea[3] = {e1, -nu * e1 * (1 - 1e-9), 0}, eb[3] = {e1, -nu * e1 * (1 + 1e-9), 0};
+  EXPECT_EQ(law.evaluate(ea, Na, Ct), MembraneWrinkleState::Taut);
+  EXPECT_EQ(law.evaluate(eb, Nb, Ct), MembraneWrinkleState::Wrinkled);
+  for (int i = 0; i < 3; ++i) EXPECT_TRUE(near(Na[i], Nb[i], Tol{1e-6 * E * h * e1, 0}));
+}
+
 namespace {
 
 struct PanelResult {
