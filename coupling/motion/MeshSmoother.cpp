@@ -208,6 +208,121 @@ void MeshSmoother::setMovingNodes(const std::vector<std::array<real, 3>>& points
   cg_ = LaplacianCgWork{};  // the AMG is set up again on the new weights
 }
 
+lid_t MeshSmoother::setColumnFeet(const std::vector<lid_t>& feet) {
+  if (!options_.columns || feet.empty()) return 0;
+  if (nodeHalo_) throw InputError("coupling.meshMotion.columns runs on one rank only");
+  auto off = Kokkos::create_mirror_view_and_copy(HostSpace(), mesh_.nodeNodeOffsets());
+  auto nb = Kokkos::create_mirror_view_and_copy(HostSpace(), mesh_.nodeNodes());
+  auto X = Kokkos::create_mirror_view_and_copy(HostSpace(), mesh_.referencePoints());
+  auto fixed = Kokkos::create_mirror_view_and_copy(HostSpace(), fixed_);
+  const lid_t nn = mesh_.nNodes();
+  std::vector<char> foot(nn, 0), claimed(nn, 0), sliding(nn, 0);
+  if (slide_.extent(0) > 0) {
+    auto sl = Kokkos::create_mirror_view_and_copy(HostSpace(), slide_);
+    for (lid_t i = 0; i < nn; ++i) sliding[i] = (sl(i, 0) != 0 || sl(i, 1) != 0 || sl(i, 2) != 0) ? 1 : 0;
+  }
+  for (lid_t f : feet) foot.at(f) = 1;
+  auto edge = [&](lid_t a, lid_t b, double e[3]) {
+    double l = 0;
+    for (int c = 0; c < 3; ++c) {
+      e[c] = X(b, c) - X(a, c);
+      l += e[c] * e[c];
+    }
+    l = std::sqrt(l);
+    for (int c = 0; c < 3; ++c) e[c] /= l;
+    return l;
+  };
+  std::vector<lid_t> hNode, hFoot;
+  std::vector<real> hWeight;
+  lid_t count = 0;
+  for (lid_t f : feet) {
+    // The one edge that leaves the surface.
+    lid_t next = -1;
+    int leaving = 0;
+    for (lid_t k = off(f); k < off(f + 1); ++k)
+      if (!foot[nb(k)]) {
+        next = nb(k);
+        ++leaving;
+      }
+    if (leaving != 1) continue;
+    std::vector<lid_t> line{f};
+    std::vector<double> s{0.0};
+    bool ok = true;
+    lid_t prev = f, cur = next;
+    double dir[3];
+    s.push_back(edge(prev, cur, dir));
+    while (ok && !fixed(cur)) {
+      if (claimed[cur] || sliding[cur] || foot[cur] || line.size() > 100000) {
+        ok = false;
+        break;
+      }
+      line.push_back(cur);
+      lid_t best = -1;
+      double bestDot = 0.5, secondDot = -2;
+      for (lid_t k = off(cur); k < off(cur + 1); ++k) {
+        const lid_t m = nb(k);
+        if (m == prev) continue;
+        double e[3];
+        edge(cur, m, e);
+        const double dot = e[0] * dir[0] + e[1] * dir[1] + e[2] * dir[2];
+        if (dot > bestDot) {
+          secondDot = bestDot;
+          bestDot = dot;
+          best = m;
+        } else {
+          secondDot = std::max(secondDot, dot);
+        }
+      }
+      if (best < 0 || secondDot > 0.5) {
+        ok = false;
+        break;
+      }
+      s.push_back(s.back() + edge(cur, best, dir));
+      prev = cur;
+      cur = best;
+    }
+    if (!ok || line.size() < 2) continue;
+    const double total = s.back();  // to the far boundary node `cur`
+    for (std::size_t k = 1; k < line.size(); ++k) {
+      claimed[line[k]] = 1;
+      hNode.push_back(line[k]);
+      hFoot.push_back(f);
+      hWeight.push_back(1 - s[k] / total);
+      fixed(line[k]) = 1;
+    }
+    ++count;
+  }
+  const lid_t n = static_cast<lid_t>(hNode.size());
+  columns_.node = IndexView("mfsi::coupling::motion::columnNode", n);
+  columns_.foot = IndexView("mfsi::coupling::motion::columnFoot", n);
+  columns_.weight = RealView("mfsi::coupling::motion::columnWeight", n);
+  auto hn = Kokkos::create_mirror_view(columns_.node);
+  auto hf = Kokkos::create_mirror_view(columns_.foot);
+  auto hw = Kokkos::create_mirror_view(columns_.weight);
+  for (lid_t i = 0; i < n; ++i) {
+    hn(i) = hNode[i];
+    hf(i) = hFoot[i];
+    hw(i) = hWeight[i];
+  }
+  Kokkos::deep_copy(columns_.node, hn);
+  Kokkos::deep_copy(columns_.foot, hf);
+  Kokkos::deep_copy(columns_.weight, hw);
+  Kokkos::deep_copy(fixed_, fixed);
+  cg_ = LaplacianCgWork{};  // the AMG is set up again without the column nodes
+  return count;
+}
+
+void MeshSmoother::applyColumns(const ExecSpace& exec) const {
+  const IndexView node = columns_.node, foot = columns_.foot;
+  const RealView w = columns_.weight;
+  const Real3View d = d_;
+  Kokkos::parallel_for(
+      "mfsi::coupling::motion::columns", RangePolicy(exec, 0, static_cast<lid_t>(node.extent(0))),
+      KOKKOS_LAMBDA(lid_t i) {
+        for (int c = 0; c < 3; ++c) d(node(i), c) = w(i) * d(foot(i), c);
+      });
+}
+
 void MeshSmoother::place(const ExecSpace& exec, const ConstReal3View& d) const {
   const Real3View x = mesh_.points();
   const ConstReal3View X0 = mesh_.referencePoints();
@@ -219,6 +334,7 @@ void MeshSmoother::place(const ExecSpace& exec, const ConstReal3View& d) const {
 
 MotionReport MeshSmoother::move(const ExecSpace& exec) {
   ScopedRegion region("mfsi::coupling::motion");
+  if (columns_.node.extent(0) > 0) applyColumns(exec);
   Kokkos::deep_copy(exec, start_, d_);  // prescribed values + the warm start
   MotionReport rep;
   auto measure = [&](int sweeps, int attempt, bool stiff) {

@@ -51,6 +51,11 @@ struct MeshSmootherOptions {
   /// Patches whose nodes slide along them (in the plane of the patch where it is flat) instead of
   /// staying put: walls next to a deflecting membrane, so the corner cells shear less.
   std::vector<std::string> slidingPatches;
+  /// Columns (setColumnFeet): the interior nodes of each line of cell edges that leaves a membrane
+  /// node and runs layer by layer to another boundary node move with that node, by a factor falling
+  /// linearly in reference arc length from 1 at the membrane to 0 at the far wall; the others are
+  /// solved as before, the column nodes prescribed. One rank only.
+  bool columns = false;
 };
 
 /// \brief What one `move` did.
@@ -87,6 +92,14 @@ class MeshSmoother {
   /// options.distanceExponent > 0 the CG's edge weights grow near them. Call before the first move.
   void setMovingNodes(const std::vector<std::array<real, 3>>& points);
 
+  /// \brief With options.columns: find the columns of nodes above the foot nodes (the membrane's nodes
+  /// on a boundary patch of an extruded, layered mesh) and prescribe their interior nodes. A column
+  /// follows, from each node, the edge best aligned with the previous one (within 60 degrees) until
+  /// it meets a boundary node; a foot with more than one edge leaving the surface, a line that
+  /// turns, meets a sliding node or another column is left to the Laplacian. Returns the number of
+  /// columns. Call before the first move. Throws InputError on a decomposed mesh.
+  lid_t setColumnFeet(const std::vector<lid_t>& feet);
+
   /// Smooth and move the mesh points; the quality guard (the minimum scaled Jacobian, from the
   /// points alone) retries as the options say. The caller recomputes whatever geometry it keeps
   /// (the fluid does, once per motion). Throws DivergenceError when a cell is still inverted, with
@@ -100,6 +113,8 @@ class MeshSmoother {
 
   /// Points = reference + d (one kernel; no fence).
   void place(const ExecSpace& exec, const ConstReal3View& d) const;
+  /// d(node) = weight d(foot) on every column node (one kernel; no fence).
+  void applyColumns(const ExecSpace& exec) const;
 
  private:
   const HexMesh& mesh_;
@@ -108,6 +123,12 @@ class MeshSmoother {
   SmoothingGraph graph_, stiff_;
   Real3View d_, work_, start_, good_;
   Real3View slide_;  ///< unit normal of sliding nodes (zero elsewhere); empty without sliding patches
+  /// Columns: node, its foot, its factor (setColumnFeet); empty without columns.
+  struct Columns {
+    IndexView node, foot;
+    RealView weight;
+  };
+  Columns columns_;
   LaplacianCgWork cg_;
   std::unique_ptr<Halo> nodeHalo_;  ///< decomposed mesh: the ghosts of the displacement
   SolverComm comm_;

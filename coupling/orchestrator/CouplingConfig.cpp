@@ -41,6 +41,12 @@ Schema couplingSchema() {
                    .atLeast(0)
                    .atMost(4),
                Default(o.motion.distanceExponent))
+          .key("columns",
+               Schema::boolean("on a mesh extruded from a membrane patch (layers of cells between it and a wall): "
+                               "the nodes of each line of cell edges from a membrane node to the wall move with that "
+                               "node, by a factor falling linearly from 1 to 0 along the line, so every layer of the "
+                               "column compresses alike; the other nodes are solved as before. One rank only"),
+               Default(false))
           .key("slidingPatches",
                Schema::list("patches whose nodes slide along them (flat walls next to a membrane)",
                             Schema::string("patch name")),
@@ -224,6 +230,7 @@ CouplingOptions readCouplingOptions(const SceneConfig& c) {
   o.motion.minScaledJacobian = c.get<double>("meshMotion.minScaledJacobian");
   o.motion.retries = c.get<int>("meshMotion.retries");
   o.motion.slidingPatches = c.get<std::vector<std::string>>("meshMotion.slidingPatches");
+  o.motion.columns = c.get<bool>("meshMotion.columns");
   for (const auto& name : c.keys("bodyPatches"))
     o.bodyPatches.push_back({name, c.get<std::vector<std::string>>("bodyPatches." + name)});
   if (c.has("lumpedChamber")) {

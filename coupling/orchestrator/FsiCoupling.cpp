@@ -135,6 +135,17 @@ FsiCoupling::FsiCoupling(const CouplingOptions& options, const SceneConfig& sect
     }
     smoother_->setMovingNodes(moving);
   }
+  if (options_.motion.columns) {
+    if (comm_ != MPI_COMM_NULL)
+      throw InputError(section.where("meshMotion.columns"), "columns run on one rank only");
+    std::vector<lid_t> feet;
+    for (const Panel& p : panels_)
+      for (lid_t v : p.module->fluidSurface()->fluidNode) feet.push_back(v);
+    if (smoother_->setColumnFeet(feet) == 0)
+      throw InputError(section.where("meshMotion.columns"),
+                       "no column of cell edges leaves the membranes' nodes (a membrane on a boundary patch of a "
+                       "mesh extruded from it is needed)");
+  }
   acceleration_ = coupling::makeAcceleration(options_.acceleration, layout);
 }
 
