@@ -5,13 +5,17 @@
 # with exit 0 and status ok; every step's coupling loop converged (none unconverged, none over
 # <iterationLimit> iterations); no NaN or Inf anywhere in steps.csv; the mesh valid (minimum scaled
 # Jacobian over the run > ${minJacobian}, default 0.5); the membrane's largest displacement finite
-# and below 0.5 (half the cavity: bounded). The membrane is ${membrane} (default bottom).
+# and below ${maxDisplacement} (default 0.5, half the cavity: bounded). The membrane is ${membrane}
+# (default bottom).
 function(stable name steps limit)
   if(NOT DEFINED minJacobian)
     set(minJacobian 0.5)
   endif()
   if(NOT DEFINED membrane)
     set(membrane bottom)
+  endif()
+  if(NOT DEFINED maxDisplacement)
+    set(maxDisplacement 0.5)
   endif()
   execute_process(COMMAND ${MFSI} run ${ARGN} --out ${WORK}/${name} RESULT_VARIABLE rc OUTPUT_VARIABLE o ERROR_VARIABLE e)
   if(NOT rc EQUAL 0)
@@ -30,7 +34,7 @@ function(stable name steps limit)
     message(SEND_ERROR "${name}: status ${status}, ${done} of ${steps} steps, ${unconverged} unconverged, "
       "at most ${worst} iterations (limit ${limit})")
   endif()
-  execute_process(COMMAND awk "BEGIN { exit !(${jac} > ${minJacobian} && ${umax} == ${umax} && ${umax} < 0.5) }"
+  execute_process(COMMAND awk "BEGIN { exit !(${jac} > ${minJacobian} && ${umax} == ${umax} && ${umax} < ${maxDisplacement}) }"
     RESULT_VARIABLE ok)
   if(NOT ok EQUAL 0)
     message(SEND_ERROR "${name}: minimum scaled Jacobian ${jac}, largest membrane displacement ${umax}")
