@@ -7,6 +7,7 @@
 //    deflection (Newmark consistent and lumped mass, generalized-alpha);
 //  - Rayleigh damping: logarithmic decrement against 2 pi zeta, zeta = alpha/(2 w) + beta w/2.
 #include "support/Approx.hpp"
+#include "support/DenseCsr.hpp"
 
 #include "structure/membrane/MembraneSolver.hpp"
 
@@ -16,6 +17,7 @@
 #include <cmath>
 
 using namespace mfsi;
+using mfsi::test::dense;
 using mfsi::test::near;
 using mfsi::test::Tol;
 
@@ -40,16 +42,6 @@ MembraneMesh squareMesh(int n) {
   rect.lx = rect.ly = kSide;
   rect.nx = rect.ny = n;
   return buildMembraneMesh(generateRectangleMesh(rect));
-}
-
-Eigen::MatrixXd dense(const CsrMatrix& A) {
-  auto rp = Kokkos::create_mirror_view_and_copy(HostSpace(), A.rowPtr);
-  auto ci = Kokkos::create_mirror_view_and_copy(HostSpace(), A.colIdx);
-  auto v = Kokkos::create_mirror_view_and_copy(HostSpace(), A.values);
-  Eigen::MatrixXd D = Eigen::MatrixXd::Zero(A.nRows, A.nCols);
-  for (lid_t i = 0; i < A.nRows; ++i)
-    for (lid_t k = rp(i); k < rp(i + 1); ++k) D(i, ci(k)) += v(k);
-  return D;
 }
 
 /// Centre-deflection history of free vibration from w = A sin(pi x) sin(pi y).

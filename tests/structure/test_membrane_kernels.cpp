@@ -7,6 +7,7 @@
 //    finite-difference matrix);
 //  - the no-atomics gathers vs serial host sums, and bitwise repeatability.
 #include "support/Approx.hpp"
+#include "support/DenseCsr.hpp"
 
 #include "structure/membrane/MembraneSolver.hpp"
 
@@ -16,6 +17,7 @@
 #include <random>
 
 using namespace mfsi;
+using mfsi::test::dense;
 using mfsi::test::near;
 using mfsi::test::Tol;
 
@@ -169,16 +171,6 @@ Eigen::MatrixXd finiteDifferenceTangent(MembraneSolver& s, const std::vector<dou
   }
   Kokkos::deep_copy(s.displacement(), toDevice(u, "u"));
   return K;
-}
-
-Eigen::MatrixXd dense(const CsrMatrix& A) {
-  auto rp = Kokkos::create_mirror_view_and_copy(HostSpace(), A.rowPtr);
-  auto ci = Kokkos::create_mirror_view_and_copy(HostSpace(), A.colIdx);
-  auto v = Kokkos::create_mirror_view_and_copy(HostSpace(), A.values);
-  Eigen::MatrixXd D = Eigen::MatrixXd::Zero(A.nRows, A.nCols);
-  for (lid_t i = 0; i < A.nRows; ++i)
-    for (lid_t k = rp(i); k < rp(i + 1); ++k) D(i, ci(k)) += v(k);
-  return D;
 }
 
 void checkTangent(MembraneWrinklingModel wrinkling, double pressure, bool symmetricPart) {
