@@ -131,12 +131,13 @@ void ParentFrames::setAccelerations(const std::vector<BodyAcceleration>& acceler
   Kokkos::deep_copy(accelerations_, h);
 }
 
-void ParentFrames::inertialForce(const ExecSpace& exec, const ConstReal3View& x, const ConstRealView& mass,
-                                 const Real3View& f) const {
+void ParentFrames::inertialForce(const ExecSpace& exec, const ConstReal3View& x, const ConstRealView& relativeVelocity,
+                                 const ConstRealView& mass, const Real3View& f) const {
   MFSI_CHECK(accelerations_.extent(0) == static_cast<std::size_t>(nBodies_),
              "parent frames: inertialForce before setAccelerations");
   const auto W = weights_;
   const auto A = accelerations_;
+  const auto F = frames_;
   const int nb = nBodies_;
   Kokkos::parallel_for(
       "mfsi::coupling::parentFrames::inertialForce", RangePolicy(exec, 0, static_cast<lid_t>(weights_.extent(0))),
@@ -147,11 +148,16 @@ void ParentFrames::inertialForce(const ExecSpace& exec, const ConstReal3View& x,
           if (w == 0) continue;
           const real r[3] = {x(i, 0) - A(b, 0), x(i, 1) - A(b, 1), x(i, 2) - A(b, 2)};
           const real o[3] = {A(b, 6), A(b, 7), A(b, 8)}, al[3] = {A(b, 9), A(b, 10), A(b, 11)};
-          real oxr[3], axr[3], ooxr[3];  // omega x r, alpha x r, omega x (omega x r)
+          real v[3];  // the relative velocity in world axes: Q v, (Q v)_j = sum_k Q_jk v_k
+          for (int j = 0; j < 3; ++j)
+            v[j] = F(b, 6 + 3 * j) * relativeVelocity(3 * i) + F(b, 7 + 3 * j) * relativeVelocity(3 * i + 1) +
+                   F(b, 8 + 3 * j) * relativeVelocity(3 * i + 2);
+          real oxr[3], axr[3], ooxr[3], oxv[3];  // omega x r, alpha x r, omega x (omega x r), omega x v
           geom::cross(o, r, oxr);
           geom::cross(al, r, axr);
           geom::cross(o, oxr, ooxr);
-          for (int k = 0; k < 3; ++k) acc[k] += w * (A(b, 3 + k) + axr[k] + ooxr[k]);
+          geom::cross(o, v, oxv);
+          for (int k = 0; k < 3; ++k) acc[k] += w * (A(b, 3 + k) + axr[k] + ooxr[k] + 2 * oxv[k]);
         }
         for (int k = 0; k < 3; ++k) f(i, k) = -mass(i) * acc[k];
       });

@@ -57,13 +57,14 @@ class ParentFrames {
     std::array<double, 3> centre{0, 0, 0}, acceleration{0, 0, 0}, omega{0, 0, 0}, alpha{0, 0, 0};
   };
   void setAccelerations(const std::vector<BodyAcceleration>& accelerations);
-  /// f(i) = -m_i sum_b w_ib (a_b + alpha_b x r + omega_b x (omega_b x r)), r = x_i - c_b: the
-  /// inertial force of node i (lumped mass m_i, position x_i) carried along by its frames. The
-  /// FEM, solved relative to the frames, takes it as a load (the frame's acceleration in its
-  /// inertia; the Coriolis term 2 omega x du/dt is left out), and the bodies take it back as the
-  /// membrane's inertia on them.
-  void inertialForce(const ExecSpace& exec, const ConstReal3View& x, const ConstRealView& mass,
-                     const Real3View& f) const;
+  /// f(i) = -m_i sum_b w_ib (a_b + alpha_b x r + omega_b x (omega_b x r) + 2 omega_b x Q_b v_i),
+  /// r = x_i - c_b: the inertial force of node i (lumped mass m_i, position x_i, velocity v_i
+  /// relative to its frames, in frame axes, 3 per node) carried along by its frames, with the
+  /// Coriolis term of its motion relative to them. The FEM, solved relative to the frames, takes
+  /// it as a load, and the bodies take it back as the membrane's inertia on them (their share of
+  /// the relative acceleration itself, m_i d2u/dt2, is left out).
+  void inertialForce(const ExecSpace& exec, const ConstReal3View& x, const ConstRealView& relativeVelocity,
+                     const ConstRealView& mass, const Real3View& f) const;
 
   /// relative(i) = sum_b w_ib Q_b^T global(i): nodal forces into the frames the FEM is solved in.
   void toFrames(const ExecSpace& exec, const ConstReal3View& global, const Real3View& relative) const;

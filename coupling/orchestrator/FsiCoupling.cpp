@@ -531,10 +531,11 @@ void FsiCoupling::updateFrameInertia() {
   for (Panel& p : panels_) {
     if (p.inertia.extent(0) == 0) continue;
     MembraneSolver& s = p.module->solver();
-    // At the step's start positions (the committed displacement): the rotational terms' lever.
+    // At the step's start state (the committed displacement and velocity): the rotational terms'
+    // lever and the Coriolis term's relative velocity.
     p.parents.setAccelerations(acc);
     p.parents.positions(exec_, s.mesh().referencePoints(), s.displacement(), p.framePosition);
-    p.parents.inertialForce(exec_, p.framePosition, s.nodalMass(), p.inertia);
+    p.parents.inertialForce(exec_, p.framePosition, s.velocity(), s.nodalMass(), p.inertia);
     if (!options_.viscousTraction) {
       p.parents.toFrames(exec_, p.inertia, p.forceFrame);
       continue;

@@ -102,3 +102,34 @@ TEST(ParentFrames, ABlendedNodeSharesItsForce) {
   // 1/2 (I + Rz(180))^T (0, 4, 0) = 1/2 ((0, 4, 0) + (0, -4, 0)) = 0.
   EXPECT_TRUE(near(hf(1, 1), 0.0, Tol{1e-14, 0}, "blended frame force"));
 }
+
+// The inertial force a frame's motion puts on a node of mass 2 at x = (1, 0, 0), the frame turned by
+// 90 degrees about z (centre of mass at the origin), a = (1, 2, 3), omega = (0, 0, 2),
+// alpha = (0, 0, 0.5): -m (a + alpha x r + omega x (omega x r) + 2 omega x Q v). At rest in the frame:
+// alpha x r = (0, 0.5, 0), omega x (omega x r) = (-4, 0, 0), so f = -2 (-3, 2.5, 3). Moving at
+// v = (1, 0, 0) in frame axes, Q v = (0, 1, 0) and the Coriolis term 2 omega x Q v = (-4, 0, 0) adds
+// 8 to f_x.
+TEST(ParentFrames, InertialForceWithCoriolis) {
+  cpl::ParentFrames pf({{1, 0, 0}}, {{0, 0, 0}}, {0}, 1);
+  pf.setTransforms({mfsi::RigidPlacement::rotationAbout({0, 0, 1}, kPi / 2, {0, 0, 0})});
+  cpl::ParentFrames::BodyAcceleration acc;
+  acc.acceleration = {1, 2, 3};
+  acc.omega = {0, 0, 2};
+  acc.alpha = {0, 0, 0.5};
+  pf.setAccelerations({acc});
+  const mfsi::ExecSpace exec;
+  const auto x = points({{1, 0, 0}});
+  mfsi::RealView mass("test::mass", 1), v("test::v", 3);
+  Kokkos::deep_copy(mass, 2.0);
+  mfsi::Real3View f("test::f", 1);
+  for (const double vx : {0.0, 1.0}) {
+    auto hv = Kokkos::create_mirror_view(v);
+    hv(0) = vx;
+    hv(1) = hv(2) = 0;
+    Kokkos::deep_copy(v, hv);
+    pf.inertialForce(exec, x, v, mass, f);
+    auto hf = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), f);
+    const double expect[3] = {6 + 8 * vx, -5, -6};
+    for (int k = 0; k < 3; ++k) EXPECT_TRUE(near(hf(0, k), expect[k], Tol{1e-13, 0}, "f, v = " + std::to_string(vx)));
+  }
+}
