@@ -144,6 +144,11 @@ Schema couplingSchema() {
                           "fluid's answer depends on the interface alone)",
                           {"lastIterate", "stepStart"}),
            Default("lastIterate"))
+      .key("predictor",
+           Schema::choice("the load of each step's first structure solve: lastLoad (the fluid's at t_n) or "
+                          "extrapolatedLoad (2 p_n - p_n-1, its linear extrapolation to t_n+1)",
+                          {"lastLoad", "extrapolatedLoad"}),
+           Default("lastLoad"))
       .key("volumeConstraint",
            Schema::boolean("when the fluid is incompressible and no boundary prescribes its pressure (a closed "
                            "chamber), the membrane patch that closes it solves each step with a volume constraint: "
@@ -217,6 +222,7 @@ CouplingOptions readCouplingOptions(const SceneConfig& c) {
   o.viscousTraction = c.get<bool>("viscousTraction");
   o.volumeConstraint = c.get<bool>("volumeConstraint");
   o.fluidFromStepStart = c.get<std::string>("fluidStart") == "stepStart";
+  o.extrapolatedPredictor = c.get<std::string>("predictor") == "extrapolatedLoad";
   o.maxMeshVelocity = c.get<double>("maxMeshVelocity");
   o.maxDeltaDispFrac = c.get<double>("maxDeltaDispFrac");
   o.motion.method = c.get<std::string>("meshMotion.method") == "jacobi" ? coupling::MeshMotionMethod::Jacobi

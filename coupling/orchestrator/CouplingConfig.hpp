@@ -82,6 +82,10 @@ struct CouplingOptions {
   /// the last iteration's answer: the fluid's answer is then a function of the interface alone,
   /// also where the fluid does not converge within its outer iterations.
   bool fluidFromStepStart = false;
+  /// The structure's predictor solve of a step takes the fluid's load at t_n (false) or its linear
+  /// extrapolation to t_n+1 from t_n and t_n-1, 2 p_n - p_n-1 (true): a first iterate closer to the
+  /// step's answer where the load changes steadily (a travelling pressure wave).
+  bool extrapolatedPredictor = false;
   coupling::MeshSmootherOptions motion;
   /// \brief A rigid body of the `bodies` section and the fluid patches that move with it.
   struct BodyPatches {

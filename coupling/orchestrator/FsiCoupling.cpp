@@ -95,6 +95,8 @@ FsiCoupling::FsiCoupling(const CouplingOptions& options, const SceneConfig& sect
     }
     p.load = RealView("mfsi::coupling::load", mm.nElements());
     p.loadPrevious = RealView("mfsi::coupling::loadPrevious", mm.nElements());
+    if (options_.extrapolatedPredictor)
+      p.loadLastStep = RealView("mfsi::coupling::loadLastStep", mm.nElements());
     p.faceVelocity = Real3View("mfsi::coupling::faceVelocity", mm.nElements());
     p.iterate = RealView("mfsi::coupling::iterate", 3 * mm.nNodes());
     if (options_.pNetSmoothIter > 0) {
@@ -515,6 +517,21 @@ void FsiCoupling::updateLoads(double scale, bool relax, double dt) {
   forceResidual_ = norm2 > 0 ? std::sqrt(change2 / norm2) : (change2 > 0 ? 1.0 : 0.0);
 }
 
+void FsiCoupling::extrapolateLoads() {
+  for (Panel& p : panels_) {
+    // p_n+1 ~ 2 p_n - p_n-1; p_n is kept for the next step.
+    const RealView load = p.load, last = p.loadLastStep;
+    const bool have = p.haveLastStep;
+    Kokkos::parallel_for(
+        "mfsi::coupling::extrapolateLoad", RangePolicy(exec_, 0, p.iface.nElements()), KOKKOS_LAMBDA(lid_t e) {
+          const real now = load(e);
+          if (have) load(e) = 2 * now - last(e);
+          last(e) = now;
+        });
+    p.haveLastStep = true;
+  }
+}
+
 void FsiCoupling::updateFrameInertia() {
   if (bodies_.empty()) return;
   const RigidBodySystem& sys = rigid_->system();
@@ -789,6 +806,7 @@ void FsiCoupling::advance(const TimeState& t) {
   }
   const double scale = loadScale(t1);
   updateLoads(scale, false, t.dt);  // the loads of the fluid at t_n (the structure goes first)
+  if (options_.extrapolatedPredictor) extrapolateLoads();
   InterfaceVector x(size_), xt(size_), good(size_);
   for (const Panel& p : panels_) toHost(p.module->solver().displacement(), good, p.offset);  // the mesh is there
   acceleration_->beginStep();
@@ -1001,6 +1019,10 @@ void FsiCoupling::saveState(io::StateWriter& w) const {
     pw.putView("faceVelocity", p.faceVelocity);
     pw.putView("filtered", p.filtered);
     pw.putBool("haveFiltered", p.haveFiltered);
+    if (options_.extrapolatedPredictor) {
+      pw.putView("loadLastStep", p.loadLastStep);
+      pw.putBool("haveLastStep", p.haveLastStep);
+    }
   }
   std::vector<double> tr;
   for (const auto& T : transforms_) {
@@ -1037,6 +1059,10 @@ void FsiCoupling::loadState(const io::StateReader& r) {
     pr.getView("faceVelocity", p.faceVelocity);
     pr.getView("filtered", p.filtered);
     p.haveFiltered = pr.boolean("haveFiltered");
+    if (options_.extrapolatedPredictor) {
+      pr.getView("loadLastStep", p.loadLastStep);
+      p.haveLastStep = pr.boolean("haveLastStep");
+    }
   }
   const auto tr = r.doubles("transforms", 15 * static_cast<long long>(transforms_.size()));
   for (std::size_t b = 0; b < transforms_.size(); ++b) transforms_[b] = RigidPlacement::fromFlat(tr.data() + 15 * b);

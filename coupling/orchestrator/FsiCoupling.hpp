@@ -131,6 +131,8 @@ class FsiCoupling final : public Module {
     RealView smoothWork;
     RealView filtered;             ///< pNetFilterTau: the filtered load of the last step
     bool haveFiltered = false;
+    RealView loadLastStep;  ///< extrapolatedPredictor: the load at the previous step's start (t_n-1)
+    bool haveLastStep = false;
     bool mounted = false;            ///< on moving bodies (parentBodyPatches): FEM relative to them
     coupling::ParentFrames parents;  ///< mounted: each node's body and the bodies' motions
   };
@@ -152,6 +154,8 @@ class FsiCoupling final : public Module {
   void updateBodyLoads(double scale);
   /// Mounted dynamic membranes: the inertial force of their mass carried by the bodies' current
   /// accelerations (Panel::inertia), and the FEM's nodal load in the frames (viscous + inertia).
+  /// extrapolatedPredictor: each panel's load becomes 2 p_n - p_n-1 (p_n kept for the next step).
+  void extrapolateLoads();
   void updateFrameInertia();
   void solveStructure(double t1, double dt);
   void gatherTrial(coupling::InterfaceVector& xt) const;

@@ -156,6 +156,14 @@ TEST(Restart, TheFlexibleCavityWithIqnIlsReuseContinuesBitwise) {
                          {"mesh.blocks.0.cells=[12,10,1]", "mesh.blocks.1.cells=[12,2,1]"}, 4);
 }
 
+// The extrapolated predictor reads the load of the step before the checkpoint's: it must be in it.
+TEST(Restart, TheExtrapolatedPredictorContinuesBitwise) {
+  expectRestartIsBitwise("flexible_cavity_extrapolated", "flexible-cavity",
+                         {"mesh.blocks.0.cells=[12,10,1]", "mesh.blocks.1.cells=[12,2,1]",
+                          "coupling.predictor=extrapolatedLoad"},
+                         4);
+}
+
 // A membrane mounted on a sprung rigid frame in a 3D channel: fluid, membrane, bodies and coupling.
 TEST(Restart, TheMembraneChannelContinuesBitwise) {
   expectRestartIsBitwise("membrane_channel", "membrane-channel", {"mesh.blocks.0.cells=[24,8,16]"}, 2);
