@@ -16,6 +16,8 @@
 # - Checkpoints on 2 ranks (one file per rank, the oldest pruned on every rank): a restart on 2
 #   ranks from the middle of the cavity run gives the same steps bit for bit; a restart on 3 ranks
 #   is refused with one message (exit 2).
+# With SHORT (the instrumented builds) the 4-rank cavity is left out and the balloon stops at
+# t = 0.5 s.
 find_program(MPIEXEC mpiexec)
 if(NOT MPIEXEC)
   message("MFSI_SKIP: no mpiexec")
@@ -67,8 +69,12 @@ set(cavity flexible-cavity --set mesh.blocks.0.cells=[12,10,1] --set mesh.blocks
 run(cavity1 1 ${cavity})
 run(cavity2 2 ${cavity})
 run(cavity2again 2 ${cavity})
-run(cavity4 4 ${cavity})
-foreach(b cavity2 cavity4)
+set(compared cavity2)
+if(NOT SHORT)
+  run(cavity4 4 ${cavity})
+  list(APPEND compared cavity4)
+endif()
+foreach(b ${compared})
   same(cavity1 ${b} 1e-10 membrane.bottom.centreUy membrane.bottom.maxVonMises fluid.max_velocity mesh.total_volume
     mesh.min_scaled_jacobian coupling.min_scaled_jacobian)
   same(cavity1 ${b} 0 coupling.mean_iterations coupling.max_iterations)
@@ -108,7 +114,11 @@ run(channel2 2 ${channel})
 same(channel1 channel2 1e-9 fluid.bar.force_x bodies.body.frame.Fx fluid.max_velocity)
 same(channel1 channel2 1e-7 membrane.panelA.centreUx membrane.panelB.centreUx)
 
-set(balloon balloon --set time.endTime=2)
+if(SHORT)
+  set(balloon balloon --set time.endTime=0.5)
+else()
+  set(balloon balloon --set time.endTime=2)
+endif()
 run(balloon1 1 ${balloon} ${tight})
 run(balloon2 2 ${balloon} ${tight})
 same(balloon1 balloon2 1e-8 membrane.top.centreUy)
