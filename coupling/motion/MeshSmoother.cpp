@@ -292,21 +292,9 @@ lid_t MeshSmoother::setColumnFeet(const std::vector<lid_t>& feet) {
     }
     ++count;
   }
-  const lid_t n = static_cast<lid_t>(hNode.size());
-  columns_.node = IndexView("mfsi::coupling::motion::columnNode", n);
-  columns_.foot = IndexView("mfsi::coupling::motion::columnFoot", n);
-  columns_.weight = RealView("mfsi::coupling::motion::columnWeight", n);
-  auto hn = Kokkos::create_mirror_view(columns_.node);
-  auto hf = Kokkos::create_mirror_view(columns_.foot);
-  auto hw = Kokkos::create_mirror_view(columns_.weight);
-  for (lid_t i = 0; i < n; ++i) {
-    hn(i) = hNode[i];
-    hf(i) = hFoot[i];
-    hw(i) = hWeight[i];
-  }
-  Kokkos::deep_copy(columns_.node, hn);
-  Kokkos::deep_copy(columns_.foot, hf);
-  Kokkos::deep_copy(columns_.weight, hw);
+  columns_.node = toDevice(hNode, "mfsi::coupling::motion::columnNode");
+  columns_.foot = toDevice(hFoot, "mfsi::coupling::motion::columnFoot");
+  columns_.weight = toDevice(hWeight, "mfsi::coupling::motion::columnWeight");
   Kokkos::deep_copy(fixed_, fixed);
   cg_ = LaplacianCgWork{};  // the AMG is set up again without the column nodes
   return count;

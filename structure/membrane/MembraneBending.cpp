@@ -89,26 +89,20 @@ MembraneHinges buildMembraneHinges(const MembraneMesh& mesh, real bendingStiffne
   const lid_t n = static_cast<lid_t>(k.size());
   MembraneHinges h;
   h.nodes = Kokkos::View<lid_t* [4], MemSpace>("mfsi::structure::membrane::hingeNodes", n);
-  h.stiffness = RealView("mfsi::structure::membrane::hingeStiffness", n);
-  h.restAngle = RealView("mfsi::structure::membrane::hingeRestAngle", n);
   auto hn = Kokkos::create_mirror_view(h.nodes);
-  auto hk = Kokkos::create_mirror_view(h.stiffness);
-  auto ht = Kokkos::create_mirror_view(h.restAngle);
+  std::vector<real> rest(n);
   for (lid_t i = 0; i < n; ++i) {
     real x[4][3], g[4][3];
     for (int a = 0; a < 4; ++a) {
       hn(i, a) = nodes[i][a];
       for (int c = 0; c < 3; ++c) x[a][c] = P[nodes[i][a]][c];
     }
-    real theta = 0;
-    MFSI_CHECK(membrane::hingeAngle(x, theta, g), "membrane bending: degenerate hinge at nodes "
-                                                      << nodes[i][0] << "-" << nodes[i][1]);
-    hk(i) = k[i];
-    ht(i) = theta;
+    MFSI_CHECK(membrane::hingeAngle(x, rest[i], g), "membrane bending: degenerate hinge at nodes "
+                                                        << nodes[i][0] << "-" << nodes[i][1]);
   }
   Kokkos::deep_copy(h.nodes, hn);
-  Kokkos::deep_copy(h.stiffness, hk);
-  Kokkos::deep_copy(h.restAngle, ht);
+  h.stiffness = toDevice(k, "mfsi::structure::membrane::hingeStiffness");
+  h.restAngle = toDevice(rest, "mfsi::structure::membrane::hingeRestAngle");
   h.hostNodes = std::move(nodes);
   return h;
 }
