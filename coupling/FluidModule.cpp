@@ -205,6 +205,11 @@ std::vector<std::string> FluidModule::stepColumns() const {
     }
   }
   for (const auto& p : reports_.pressureDifferences) columns.push_back(p.name);
+  for (const auto& p : reports_.flows) {
+    columns.push_back(p + ".flowRate");
+    columns.push_back(p + ".pressure");
+  }
+  if (reports_.meanPressure) columns.push_back("meanPressure");
   return columns;
 }
 
@@ -226,6 +231,11 @@ void FluidModule::appendStepValues(std::vector<double>& v) const {
     }
   }
   for (const auto& p : reports_.pressureDifferences) v.push_back(pressureDifference(p.from, p.to, p.patch));
+  for (const auto& p : reports_.flows) {
+    const PatchFlow f = patchFlow(solver_, p);
+    v.insert(v.end(), {f.flowRate, f.meanPressure});
+  }
+  if (reports_.meanPressure) v.push_back(meanPressure(solver_));
 }
 
 GhiaErrors FluidModule::ghiaCheck() const {

@@ -330,6 +330,16 @@ Schema fluidSchema() {
                             .key("name", Schema::string("column name"))
                             .key("point", Schema::realVector(3, "point", "m"))),
            Presence::Optional)
+      .key("flows",
+           Schema::list("patches whose flow is written every step (steps.csv columns fluid.<patch>.flowRate, the "
+                        "volumetric flow out of the fluid, and fluid.<patch>.pressure, the area-weighted mean of "
+                        "its boundary pressure)",
+                        Schema::string("patch name")),
+           Presence::Optional)
+      .key("meanPressure",
+           Schema::boolean("write the volume-weighted mean pressure every step (steps.csv column "
+                           "fluid.meanPressure)"),
+           Default(false))
       .key("ghia",
            Schema::map("compare a lid-driven cavity (mesh bounding box in x, y; lid at y max moving in +x) with "
                        "Ghia, Ghia & Shin (1982): metrics fluid.ghia_u_max_err, fluid.ghia_v_max_err")
@@ -446,6 +456,12 @@ FluidReports readFluidReports(const SceneConfig& c, const HexMesh& mesh, const F
     const SceneConfig p = c.child("probes." + std::to_string(i));
     r.probes.push_back({p.get<std::string>("name"), vec3(p, "point")});
   }
+  for (std::size_t i = 0; i < c.size("flows"); ++i) {
+    const std::string key = "flows." + std::to_string(i), patch = c.get<std::string>(key);
+    if (mesh.findPatch(patch) < 0) throw InputError(c.where(key), mesh.noPatchMessage(patch));
+    r.flows.push_back(patch);
+  }
+  r.meanPressure = c.get<bool>("meanPressure");
   if (c.has("ghia") && c.get<bool>("ghia.enabled")) {
     r.ghia.enabled = true;
     r.ghia.re = std::stoi(c.get<std::string>("ghia.re"));

@@ -22,6 +22,8 @@
 ///     - {patch: cylinder, referenceVelocity: 0.2, referenceArea: 0.001}
 ///   pressureDifferences:
 ///     - {name: dp, from: [0.15, 0.2, 0], to: [0.25, 0.2, 0], patch: cylinder}
+///   flows: [inlet, outlet]       # flow rate and mean pressure of each, every step
+///   meanPressure: true           # the volume-weighted mean pressure, every step
 ///   ghia: {re: 100, lidSpeed: 1}
 ///   divergenceVelocityFactor: 100  # stop as diverged when max |U| > 100 x the scene's velocity scale
 ///   means: {start: 5}              # UMean, pMean from t = 5 on, in the field output
@@ -87,6 +89,8 @@ struct FluidReports {
   std::vector<ForceReport> forces;
   std::vector<PressureDifferenceReport> pressureDifferences;
   std::vector<ProbeReport> probes;
+  std::vector<std::string> flows;  ///< patches whose flow rate and mean pressure are written
+  bool meanPressure = false;       ///< the volume-weighted mean pressure written every step
   GhiaReport ghia;
 };
 

@@ -97,6 +97,42 @@ PatchLoads patchLoads(const FluidSolver& fluid, const std::string& name, const V
   return out;
 }
 
+PatchFlow patchFlow(const FluidSolver& fluid, const std::string& patch) {
+  const HexMesh& mesh = fluid.mesh();
+  const auto& p = mesh.patches()[mesh.patchIndex(patch)];
+  ConstRealView sm = fluid.geometry().faceAreaMag, phi = fluid.faceFlux(), pb = fluid.boundaryPressure();
+  ConstIndexView own = mesh.faceOwner();
+  const lid_t start = p.start, nIn = mesh.nInternalFaces(), nOwned = fluid.ownedCells();
+  real r[3] = {0, 0, 0};
+  // On a decomposed mesh a ghost cell's patch faces are its owner rank's: counted there.
+  Kokkos::parallel_reduce(
+      "mfsi::fluid::loads::patchFlow", RangePolicy(ExecSpace(), 0, p.size),
+      KOKKOS_LAMBDA(lid_t k, real & q, real & pA, real & A) {
+        const lid_t f = start + k;
+        if (own(f) >= nOwned) return;
+        q += phi(f);
+        pA += pb(f - nIn) * sm(f);
+        A += sm(f);
+      },
+      r[0], r[1], r[2]);
+  fluid.comm().globalSum(r, 3);
+  return {r[0], r[2] > 0 ? r[1] / r[2] : 0, r[2]};
+}
+
+real meanPressure(const FluidSolver& fluid) {
+  ConstRealView V = fluid.geometry().cellVolume, pc = fluid.pressure();
+  real r[2] = {0, 0};
+  Kokkos::parallel_reduce(
+      "mfsi::fluid::loads::meanPressure", RangePolicy(ExecSpace(), 0, fluid.ownedCells()),
+      KOKKOS_LAMBDA(lid_t c, real & pV, real & sumV) {
+        pV += pc(c) * V(c);
+        sumV += V(c);
+      },
+      r[0], r[1]);
+  fluid.comm().globalSum(r, 2);
+  return r[1] > 0 ? r[0] / r[1] : 0;
+}
+
 void baffleNetPressure(const FluidSolver& fluid, const std::string& baffle, const RealView& pNet) {
   const HexMesh& mesh = fluid.mesh();
   const int m = mesh.findPatch(baffle + "_master"), s = mesh.findPatch(baffle + "_slave");

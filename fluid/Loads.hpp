@@ -30,6 +30,19 @@ void boundaryTraction(const FluidSolver& fluid, const std::string& patch, const 
 /// a baffle name (the two sides' pressure parts then give the net load on the membrane).
 PatchLoads patchLoads(const FluidSolver& fluid, const std::string& name, const Vec3& point = {0, 0, 0});
 
+/// \brief Flow through a patch: the volumetric flow rate out of the fluid, sum_f u_f . S_f
+/// (absolute velocity; the mesh flux is not subtracted, so a moving patch counts the fluid it
+/// carries), and the area-weighted mean of the boundary pressure.
+struct PatchFlow {
+  real flowRate = 0;      ///< [m^3/s], positive out of the fluid
+  real meanPressure = 0;  ///< [Pa]
+  real area = 0;          ///< [m^2]
+};
+PatchFlow patchFlow(const FluidSolver& fluid, const std::string& patch);
+
+/// \brief Volume-weighted mean of the cell pressure over the fluid [Pa].
+real meanPressure(const FluidSolver& fluid);
+
 /// \brief Net pressure across a baffle per face pair: pNet(i) = p(master face i) - p(slave face i)
 /// [Pa]. The master's outward normal is the baffle normal, so the pressure load on the membrane is
 /// pNet times the baffle normal (pointing from the master side to the slave side).
