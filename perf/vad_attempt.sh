@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # The pulsatile VAD, work in progress (issue 17): builds the blood chamber's mesh, runs
-# perf/scenes/vad_lumped.yaml and reports how far it gets (its stop reason, the time reached, the
-# membrane's centre deflection and the air chamber's pressure there, FSI iterations per step).
+# perf/scenes/vad_lumped.yaml and reports how far it gets and each cycle (perf/plot_vad.py: wall
+# time, FSI iterations, mesh quality, the membrane's centre, outlet and chamber pressures, the
+# volume balance; a figure in $VAD_PNG, by default $WORK/vad.png).
 #
 #   perf/vad_attempt.sh              # ~1 min on 1 thread
 #   perf/vad_attempt.sh --set coupling.interfaceMass=5    # extra options go to mfsi run
@@ -18,18 +19,4 @@ $py "$repo/scripts/vad_mesh.py" --blood-only ${VAD_MESH_ARGS:-} "$work/vad_blood
 cp "$repo/perf/scenes/vad_lumped.yaml" "$work/"
 export OMP_PROC_BIND=false
 "$mfsi" run "$work/vad_lumped.yaml" --out "$work/out" --overwrite --threads 1 "$@" > "$work/run.log" 2>&1 || true
-$py - "$work/out" <<'PY'
-import csv, json, sys
-out = sys.argv[1]
-s = json.load(open(out + "/summary.json"))
-rows = list(csv.DictReader(open(out + "/steps.csv")))
-its = [int(r["coupling.iterations"]) for r in rows]
-print("status:", s["status"], "-", s.get("error", ""))
-if rows:
-    r = rows[-1]
-    print("reached t = %s s of 1.5 (%d steps), wall %.1f s" % (r["time"], len(rows), s["wall_s"]))
-    print("membrane centre deflection %.2f mm, largest displacement %.2f mm" % (
-        1000 * float(r["membrane.membrane.centreDeflection"]), 1000 * float(r["membrane.membrane.maxDisplacement"])))
-    print("air chamber pressure %.1f mmHg, FSI iterations per step %.2f (max %d)" % (
-        float(r["coupling.chamberPressure"]) / 133.322, sum(its) / len(its), max(its)))
-PY
+$py "$repo/perf/plot_vad.py" "$work/out" --png "${VAD_PNG:-$work/vad.png}"
