@@ -174,7 +174,7 @@ bool sameFolder(const std::string& a, const std::string& b) {
 }
 
 int commandRun(std::string sceneArg, const std::vector<std::string>& sets, std::string out, bool overwrite,
-               const std::string& restart, const std::string& partitionMap) {
+               const std::string& restart, bool allowChanges, const std::string& partitionMap) {
   const double t0 = mfsi::wallSeconds();
   mfsi::installInterruptHandlers();
   // --restart: the checkpoint, the folder of the run that wrote it (the default --out: the run
@@ -248,10 +248,12 @@ int commandRun(std::string sceneArg, const std::vector<std::string>& sets, std::
       summary.nodes = sim->mesh().nNodes();
     }
     if (!checkpoint.empty()) {
-      sim->restore(checkpoint);
-      if (rank == 0)
+      const std::vector<std::string> changes = sim->restore(checkpoint, allowChanges);
+      if (rank == 0) {
         std::cout << "continuing from " << checkpoint << " (step " << sim->completedSteps() << ", t = "
                   << sim->completedTime() << ")\n";
+        for (const std::string& c : changes) std::cout << "  changed on restart: " << c << "\n";
+      }
     }
     started = true;
     if (rank == 0) mfsi::writeTextAtomically(out + "/scene.yaml", resolved);
@@ -289,7 +291,7 @@ int commandRun(std::string sceneArg, const std::vector<std::string>& sets, std::
     summary.error = e.what();
     // The last good state, when the run saved one (checkpoints are written after complete steps).
     if (sim && !sim->lastCheckpoint().empty())
-      summary.error += "; last good checkpoint: " + sim->lastCheckpoint() + " (mfsi run --restart it with other settings)";
+      summary.error += "; last good checkpoint: " + sim->lastCheckpoint() + " (mfsi run --restart it --allow-changes --set ... to go on with other settings)";
     report("diverged: " + summary.error);
     code = 3;
   } catch (const mfsi::OutputError& e) {
@@ -363,6 +365,7 @@ int main(int argc, char** argv) {
   int threads = 0;
   bool describe = false;
   bool overwrite = false;
+  bool allowChanges = false;
 
   auto* run = app.add_subcommand("run", "run a scene (default: the built-in default scene)");
   run->add_option("scene", scene, "scene file, or the name of a built-in scene");
@@ -370,9 +373,14 @@ int main(int argc, char** argv) {
   run->add_option("--set", sets, "override a scene value: --set a.b.c=value (repeatable)")->allow_extra_args(false);
   run->add_option("--out", out, "output folder (default: results/<scene>)");
   run->add_flag("--overwrite", overwrite, "replace the results of an earlier run in the output folder");
-  run->add_option("--restart", restart,
+  auto* restartOption = run->add_option("--restart", restart,
                   "continue a run from a checkpoint: its folder (the latest checkpoint in it) or a checkpoint "
                   "file; the scene defaults to the run's scene.yaml and --out to its folder (continuing its files)");
+  run->add_flag("--allow-changes", allowChanges,
+                "with --restart: let the scene differ from the checkpoint's in other settings than time.endTime, "
+                "time.maxSteps and output (not the mesh nor time.dt), e.g. to go on from a diverged run's last "
+                "good checkpoint with other solver settings")
+      ->needs(restartOption);
   run->add_option("--threads", threads, "host threads (default: OMP_NUM_THREADS or all cores)")->check(CLI::PositiveNumber);
   run->add_option("--partition", partitionMap,
                   "on several ranks: the cell -> rank map `mfsi partition` wrote, instead of METIS at start-up");
@@ -464,7 +472,7 @@ int main(int argc, char** argv) {
     if (app.got_subcommand("partition")) {
       code = worldRank == 0 ? commandPartition(scene, sets, partitionRanks, partitionOut) : 0;
     } else if (app.got_subcommand("run")) {
-      code = commandRun(scene, sets, out, overwrite, restart, partitionMap);
+      code = commandRun(scene, sets, out, overwrite, restart, allowChanges, partitionMap);
     } else if (app.got_subcommand("plot")) {
       code = commandPlot(plotDir, plotOut);
     } else if (app.got_subcommand("check")) {

@@ -505,7 +505,7 @@ std::string Simulation::runFolderOf(const std::string& checkpointFile) {
   return (dir.filename() == "checkpoints" ? dir.parent_path() : dir).string();
 }
 
-void Simulation::restore(const std::string& checkpointFile) {
+std::vector<std::string> Simulation::restore(const std::string& checkpointFile, bool allowChanges) {
   ScopedTimer timer(timers_, "restore");
   io::Hdf5File file = [&] {
     try {
@@ -525,11 +525,18 @@ void Simulation::restore(const std::string& checkpointFile) {
                      "(a different METIS?)");
   const std::string before = run.text("scene");
   std::string refused;
-  for (const std::string& d : sceneDifferences(before, sceneText_))
-    if (!restartMayChange(d)) refused += "\n  " + d;
+  std::vector<std::string> accepted;
+  for (const std::string& d : sceneDifferences(before, sceneText_)) {
+    if (restartMayChange(d)) continue;
+    if (allowChanges && d.rfind("mesh.", 0) != 0 && d.rfind("time.dt:", 0) != 0)
+      accepted.push_back(d);
+    else
+      refused += "\n  " + d;
+  }
   if (!refused.empty())
     throw InputError("--restart: the scene differs from the one that wrote '" + checkpointFile +
-                     "' in what the run computes (only time.endTime, time.maxSteps and output may change):" + refused);
+                     "' in what the run computes (only time.endTime, time.maxSteps and output may change; with "
+                     "--allow-changes anything but the mesh and time.dt):" + refused);
   StartState& st = start_;
   st.time.step = static_cast<int>(run.integer("step"));
   const auto tv = run.doubles("time", 5);
@@ -577,6 +584,7 @@ void Simulation::restore(const std::string& checkpointFile) {
   st.restored = true;
   completedSteps_ = st.time.step;
   completedTime_ = st.time.time;
+  return accepted;
 }
 
 }  // namespace mfsi

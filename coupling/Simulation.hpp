@@ -73,8 +73,11 @@ class Simulation {
 
   /// Put the run into the state a checkpoint holds, bitwise. The scene may differ from the one
   /// that wrote the checkpoint in time.endTime, time.maxSteps, output, name and description
-  /// alone; anything else is refused with the list of changes. Throws InputError.
-  void restore(const std::string& checkpointFile);
+  /// alone; anything else is refused with the list of changes. With `allowChanges` the other
+  /// settings may change too (to go on from a diverged run's last good state with other solver
+  /// settings: the run then no longer repeats one that was not stopped), but not the mesh nor
+  /// time.dt; the changes accepted are returned. Throws InputError.
+  std::vector<std::string> restore(const std::string& checkpointFile, bool allowChanges = false);
   /// The checkpoint to continue a run from: `path` itself (a file), or the latest checkpoint in
   /// `<path>/checkpoints/`. Throws InputError when there is none.
   static std::string findCheckpoint(const std::string& path);

@@ -142,6 +142,28 @@ TEST(Restart, AChangedSceneIsRefusedWithWhatChanged) {
   EXPECT_EQ(longer.completedSteps(), 2);
 }
 
+// --allow-changes: other settings may change (to go on from a diverged run's last good state),
+// listed back; the mesh and the time step may not.
+TEST(Restart, AllowedChangesAreListedButNotTheMeshNorTheTimeStep) {
+  const std::string dir = mfsi::test::freshDir("restart_allowed_changes");
+  {
+    mfsi::Simulation sim(scene(kCavity3d, {"time.maxSteps=2", "output.checkpoint.final=true"}));
+    sim.run(dir, false);
+  }
+  const std::string checkpoint = mfsi::Simulation::findCheckpoint(dir);
+  mfsi::Simulation changed(scene(kCavity3d, {"fluid.nu=0.02", "fluid.pimple.outerCorrectors=3", "time.maxSteps=4"}));
+  const std::vector<std::string> changes = changed.restore(checkpoint, true);
+  ASSERT_EQ(changes.size(), 2u);
+  EXPECT_NE(changes[0].find("0.02"), std::string::npos) << changes[0];
+  EXPECT_EQ(changed.completedSteps(), 2);
+  const std::string out = mfsi::test::freshDir("restart_allowed_changes_out");
+  EXPECT_EQ(changed.run(out, false).steps, 4);
+  for (const std::string& set : {std::string("mesh.blocks.0.cells=[10, 10, 10]"), std::string("time.dt=0.01")}) {
+    mfsi::Simulation refused(scene(kCavity3d, {set, "time.maxSteps=4"}));
+    EXPECT_THROW(refused.restore(checkpoint, true), mfsi::InputError) << set;
+  }
+}
+
 TEST(Restart, TheMembraneSquaresDynamicsContinueBitwise) {
   expectRestartIsBitwise("membrane_square", "membrane-square", {"membranes.0.mesh.rectangle.cells=[6,6]"}, 6);
 }
