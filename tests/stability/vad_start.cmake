@@ -2,9 +2,11 @@
 # scripts/vad_mesh.py --blood-only): the air chamber, lumped behind the membrane, fills at the
 # ejection pulse's rate and pushes the domed membrane (plate bending, tension field with a residual
 # stiffness) into the blood, which leaves through the open outlet's resistance. Every step's
-# coupling converges (measured 4 iterations per step, 9 at most; asserted at most 12), the mesh keeps
-# its starting quality, and the air chamber's pressure climbs from p0 = 65 mmHg to the outlet's
-# working range (measured 106.0 mmHg at t = 0.04 s; asserted 95-115). The whole ejection is in perf/ (perf/vad_attempt.sh, perf/RESULTS.md).
+# coupling converges (measured 3.95 iterations per step, 10 at most; asserted at most 12), the mesh
+# keeps its starting quality, and the air chamber's pressure climbs from p0 = 65 mmHg to the
+# outlet's working range: above the outlet's p0 + C_r q = 88 mmHg at t = 0.04 s (q = 169 cm^3/s)
+# by what drives the blood through the chamber (measured 98.7 mmHg; asserted 90-110). The whole
+# ejection is in perf/ (perf/vad_attempt.sh, perf/RESULTS.md).
 include(${CMAKE_CURRENT_LIST_DIR}/lib/Checks.cmake)
 file(REMOVE_RECURSE ${WORK})
 file(MAKE_DIRECTORY ${WORK})
@@ -31,8 +33,8 @@ list(FIND header coupling.chamberPressure col)
 list(GET rows -1 last)
 string(REPLACE "," ";" last "${last}")
 list(GET last ${col} p)
-execute_process(COMMAND awk "BEGIN { exit !(${p} > 95 * 133.322 && ${p} < 115 * 133.322) }" RESULT_VARIABLE ok)
+execute_process(COMMAND awk "BEGIN { exit !(${p} > 90 * 133.322 && ${p} < 110 * 133.322) }" RESULT_VARIABLE ok)
 if(NOT ok EQUAL 0)
-  message(SEND_ERROR "vad_start: the air chamber's pressure at t = 0.04 s is ${p} Pa, outside 95-115 mmHg")
+  message(SEND_ERROR "vad_start: the air chamber's pressure at t = 0.04 s is ${p} Pa, outside 90-110 mmHg")
 endif()
 message(STATUS "vad_start: air chamber at ${p} Pa after 40 ms")
