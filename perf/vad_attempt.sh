@@ -4,7 +4,7 @@
 # time, FSI iterations, mesh quality, the membrane's centre, outlet and chamber pressures, the
 # volume balance; a figure in $VAD_PNG, by default $WORK/vad.png).
 #
-#   perf/vad_attempt.sh              # ~1 min on 1 thread
+#   perf/vad_attempt.sh              # ~8 min on 1 thread (to where it stops, t = 0.395 s)
 #   perf/vad_attempt.sh --set coupling.interfaceMass=5    # extra options go to mfsi run
 #   VAD_MESH_ARGS="--around 48 --ring 9" perf/vad_attempt.sh  # options of scripts/vad_mesh.py
 set -euo pipefail

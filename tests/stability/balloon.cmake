@@ -85,8 +85,8 @@ math(EXPR savedEnd "${savedSteps} / 20")
 execute_process(COMMAND ${MFSI} run balloon --set time.endTime=${savedEnd} --set output.checkpoint.everySteps=${restartAt}
   --out ${WORK}/saved RESULT_VARIABLE rc1 OUTPUT_QUIET ERROR_QUIET)
 file(COPY ${WORK}/saved/ DESTINATION ${WORK}/continued)
-string(REGEX MATCH ".........$" padded "000000000${restartAt}")
-execute_process(COMMAND ${MFSI} run --restart ${WORK}/continued/checkpoints/checkpoint_${padded}.h5
+# The folder's latest checkpoint: step ${restartAt}, the only one written.
+execute_process(COMMAND ${MFSI} run --restart ${WORK}/continued
   --out ${WORK}/continued RESULT_VARIABLE rc2 OUTPUT_QUIET ERROR_VARIABLE e)
 file(STRINGS ${WORK}/saved/steps.csv a)
 file(STRINGS ${WORK}/continued/steps.csv b)
