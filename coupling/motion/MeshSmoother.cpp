@@ -320,13 +320,57 @@ void MeshSmoother::place(const ExecSpace& exec, const ConstReal3View& d) const {
       });
 }
 
+namespace {
+/// d += sign * base on every node.
+void addBase(const ExecSpace& exec, const Real3View& d, const ConstReal3View& base, real sign) {
+  Kokkos::parallel_for(
+      "mfsi::coupling::motion::addBase", RangePolicy(exec, 0, static_cast<lid_t>(d.extent(0))),
+      KOKKOS_LAMBDA(lid_t i) {
+        for (int c = 0; c < 3; ++c) d(i, c) += sign * base(i, c);
+      });
+}
+}  // namespace
+
+void MeshSmoother::subtractBase(const ExecSpace& exec) const {
+  // Prescribed values less the base; the free nodes' warm start is the last motion's remainder:
+  // d - last base (their d holds the last total), and on a sliding node only its tangential part,
+  // its normal component being data (total zero).
+  const Real3View d = d_;
+  const ConstReal3View base = base_, last = lastBase_, sn = slide_;
+  const auto fixed = fixed_;
+  const bool sliding = sn.extent(0) > 0;
+  Kokkos::parallel_for(
+      "mfsi::coupling::motion::subtractBase", RangePolicy(exec, 0, static_cast<lid_t>(d.extent(0))),
+      KOKKOS_LAMBDA(lid_t i) {
+        real delta[3] = {0, 0, 0};
+        if (fixed(i) == 0) {
+          for (int c = 0; c < 3; ++c) delta[c] = base(i, c) - last(i, c);
+          if (sliding) {
+            const real dn = delta[0] * sn(i, 0) + delta[1] * sn(i, 1) + delta[2] * sn(i, 2);
+            for (int c = 0; c < 3; ++c) delta[c] -= dn * sn(i, c);
+          }
+        }
+        for (int c = 0; c < 3; ++c) d(i, c) += delta[c] - base(i, c);
+      });
+}
+
 MotionReport MeshSmoother::move(const ExecSpace& exec) {
   ScopedRegion region("mfsi::coupling::motion");
   if (columns_.node.extent(0) > 0) applyColumns(exec);
+  const bool based = base_.extent(0) > 0;
+  // The Laplacian smooths what the base leaves: d - base (the interior's warm start too).
+  if (based) {
+    if (lastBase_.extent(0) != base_.extent(0)) lastBase_ = Real3View("mfsi::coupling::motion::lastBase", base_.extent(0));
+    subtractBase(exec);
+  }
   Kokkos::deep_copy(exec, start_, d_);  // prescribed values + the warm start
   MotionReport rep;
   auto measure = [&](int sweeps, int attempt, bool stiff) {
-    place(exec, d_);
+    if (based) {
+      Kokkos::deep_copy(exec, work_, d_);
+      addBase(exec, work_, base_, 1);
+    }
+    place(exec, based ? work_ : d_);
     rep = MotionReport{sweeps, attempt, stiff, -comm_.globalMax(-minScaledJacobian(exec, mesh_))};
   };
   if (options_.method == MeshMotionMethod::ConjugateGradient) {
@@ -352,6 +396,7 @@ MotionReport MeshSmoother::move(const ExecSpace& exec) {
       if (rep.minScaledJacobian >= options_.minScaledJacobian) break;
     }
   }
+  if (based) addBase(exec, d_, base_, 1);
   if (!(rep.minScaledJacobian > 0)) {
     Kokkos::deep_copy(exec, d_, good_);
     place(exec, d_);
@@ -363,6 +408,7 @@ MotionReport MeshSmoother::move(const ExecSpace& exec) {
     throw DivergenceError(os.str());
   }
   Kokkos::deep_copy(exec, good_, d_);
+  if (based) Kokkos::deep_copy(exec, lastBase_, base_);
   return rep;
 }
 

@@ -111,10 +111,19 @@ class MeshSmoother {
   void saveState(io::StateWriter& w) const;
   void loadState(const io::StateReader& r);
 
+  /// \brief A displacement field the Laplacian does not smooth (the bodies' distance-weighted
+  /// rigid motion, RigidBlend), refreshed by the caller before each `move`: the motion smooths
+  /// d - base with the prescribed values less base, and the mesh takes base plus the result. The
+  /// prescribed entries of `displacement()` stay totals; sliding nodes keep their total normal
+  /// component (zero). Empty (the default): no base.
+  void setBase(const Real3View& base) { base_ = base; }
+
   /// Points = reference + d (one kernel; no fence).
   void place(const ExecSpace& exec, const ConstReal3View& d) const;
   /// d(node) = weight d(foot) on every column node (one kernel; no fence).
   void applyColumns(const ExecSpace& exec) const;
+  /// With a base: d -= base on prescribed nodes; the free ones start from the last remainder.
+  void subtractBase(const ExecSpace& exec) const;
 
  private:
   const HexMesh& mesh_;
@@ -122,6 +131,8 @@ class MeshSmoother {
   Kokkos::View<std::uint8_t*, MemSpace> fixed_;
   SmoothingGraph graph_, stiff_;
   Real3View d_, work_, start_, good_;
+  Real3View base_;      ///< setBase; empty: none
+  Real3View lastBase_;  ///< the base of the last accepted motion (zero before the first)
   Real3View slide_;  ///< unit normal of sliding nodes (zero elsewhere); empty without sliding patches
   /// Columns: node, its foot, its factor (setColumnFeet); empty without columns.
   struct Columns {

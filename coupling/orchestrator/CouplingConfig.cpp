@@ -2,6 +2,8 @@
 
 #include "fluid/FluidConfig.hpp"
 
+#include <algorithm>
+
 namespace mfsi {
 
 Schema couplingSchema() {
@@ -50,6 +52,17 @@ Schema couplingSchema() {
           .key("slidingPatches",
                Schema::list("patches whose nodes slide along them (flat walls next to a membrane)",
                             Schema::string("patch name")),
+               Presence::Optional)
+          .key("bodies",
+               Schema::freeMap(
+                   "distance-weighted rigid motion of the mesh around coupled bodies (the seed's section 3.2): body "
+                   "name (one of bodyPatches) -> its distances; nodes within innerDistance of the body's patches "
+                   "move rigidly with it, beyond outerDistance not at all, in between by a cosine blend of its "
+                   "motion (rotation angle and translation scaled alike); the Laplacian smooths what is left",
+                   Schema::map("the body's reach")
+                       .key("innerDistance", Schema::real("distance within which the mesh moves rigidly", "m").atLeast(0))
+                       .key("outerDistance",
+                            Schema::real("distance beyond which the mesh does not follow the body", "m").atLeast(0))),
                Presence::Optional);
   return Schema::map("two-way fluid-structure coupling of the fluid and the membranes cut from its mesh")
       .key("scheme",
@@ -239,6 +252,17 @@ CouplingOptions readCouplingOptions(const SceneConfig& c) {
   o.motion.columns = c.get<bool>("meshMotion.columns");
   for (const auto& name : c.keys("bodyPatches"))
     o.bodyPatches.push_back({name, c.get<std::vector<std::string>>("bodyPatches." + name)});
+  for (const auto& name : c.keys("meshMotion.bodies")) {
+    const std::string key = "meshMotion.bodies." + name;
+    CouplingOptions::BodyReach r{name, c.get<double>(key + ".innerDistance"), c.get<double>(key + ".outerDistance")};
+    if (!(r.outerDistance > r.innerDistance))
+      throw InputError(c.where(key + ".outerDistance"), "outerDistance must exceed innerDistance (" +
+                                                             std::to_string(r.innerDistance) + ")");
+    if (std::find_if(o.bodyPatches.begin(), o.bodyPatches.end(),
+                     [&](const CouplingOptions::BodyPatches& b) { return b.body == name; }) == o.bodyPatches.end())
+      throw InputError(c.where(key), "body '" + name + "' is not one of coupling.bodyPatches");
+    o.bodyReach.push_back(r);
+  }
   if (c.has("lumpedChamber")) {
     o.lumpedChamber.membrane = c.get<std::string>("lumpedChamber.membrane");
     o.lumpedChamber.flowRate = c.get<double>("lumpedChamber.flowRate");

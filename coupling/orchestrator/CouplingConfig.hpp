@@ -22,7 +22,7 @@
 ///   interfaceMass: 0        # artificial added mass (kg/m^2) of a coupling iteration, gone at convergence
 ///   volumeConstraint: true  # a membrane closing an incompressible fluid with no pressure boundary keeps its volume in step with the inflow
 ///   lumpedChamber: {membrane: diaphragm, flowRate: 3.19e-4, timeFunction: {...}}  # an unmeshed gas chamber behind a membrane
-///   meshMotion: {sweeps: 50, minScaledJacobian: 0.05}
+///   meshMotion: {sweeps: 50, minScaledJacobian: 0.05, bodies: {frame: {innerDistance: 0.1, outerDistance: 0.5}}}
 ///   bodyPatches: {piston: [pistonFace]}   # rigid bodies (the `bodies` section) and the fluid patches they carry
 ///   parentBodyPatches: {sail: [mast]}     # membranes mounted on those bodies (nearest listed patch)
 /// \endcode
@@ -93,6 +93,13 @@ struct CouplingOptions {
     std::vector<std::string> patches;
   };
   std::vector<BodyPatches> bodyPatches;  ///< empty: no body is coupled
+  /// \brief How far a coupled body carries the mesh rigidly (`meshMotion.bodies`, coupling/motion/RigidBlend).
+  struct BodyReach {
+    std::string body;
+    double innerDistance = 0;
+    double outerDistance = 0;
+  };
+  std::vector<BodyReach> bodyReach;  ///< empty: the Laplacian alone carries the bodies' motion
   /// \brief A membrane mounted on moving bodies: each of its nodes follows the body whose listed
   /// patch (one of bodyPatches') is nearest, and its FEM displacement is relative to that body.
   struct ParentPatches {

@@ -126,6 +126,18 @@ FsiCoupling::FsiCoupling(const CouplingOptions& options, const SceneConfig& sect
   smoother_ = comm_ != MPI_COMM_NULL
                   ? std::make_unique<coupling::MeshSmoother>(mesh_, options_.motion, *domain, whole_)
                   : std::make_unique<coupling::MeshSmoother>(mesh_, options_.motion);
+  if (!options_.bodyReach.empty()) {
+    std::vector<coupling::RigidBlend::Body> reach;
+    for (const auto& r : options_.bodyReach) {
+      const auto it = std::find_if(bodies_.begin(), bodies_.end(), [&](const CoupledBody& b) { return b.name == r.body; });
+      reach_.slot.push_back(static_cast<int>(it - bodies_.begin()));
+      reach.push_back({coupling::BodyPatchMotion(whole_, it->patches).hostNodes(), r.innerDistance, r.outerDistance});
+    }
+    reach_.blend = coupling::RigidBlend(whole_, reach, mesh_);
+    reach_.base = Real3View("mfsi::coupling::rigidBase", mesh_.nNodes());
+    reach_.transforms.resize(reach.size());
+    smoother_->setBase(reach_.base);
+  }
   if (options_.motion.distanceExponent > 0) {
     std::vector<std::array<real, 3>> moving;
     auto X = Kokkos::create_mirror_view_and_copy(HostSpace(), whole_.referencePoints());
@@ -719,6 +731,10 @@ void FsiCoupling::placeBodies(const InterfaceVector& x) {
     transforms_[slot] =
         placementFromStart(b.com0, b.rotation0, kin.bodies[b.index].com, kin.bodies[b.index].frame.rotation);
     b.motion.apply(exec_, transforms_[slot], smoother_->displacement());
+  }
+  if (!reach_.blend.empty()) {
+    for (std::size_t i = 0; i < reach_.slot.size(); ++i) reach_.transforms[i] = transforms_[reach_.slot[i]];
+    reach_.blend.displacement(exec_, reach_.transforms, reach_.base);
   }
   for (Panel& p : panels_)
     if (p.mounted) p.parents.setTransforms(transforms_);

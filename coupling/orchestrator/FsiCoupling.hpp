@@ -41,6 +41,7 @@
 #include "coupling/RigidModule.hpp"
 #include "coupling/motion/BodyPatchMotion.hpp"
 #include "coupling/motion/ParentFrames.hpp"
+#include "coupling/motion/RigidBlend.hpp"
 #include "coupling/interface/MembraneInterface.hpp"
 #include "coupling/interface/SurfaceGather.hpp"
 #include "coupling/motion/MeshSmoother.hpp"
@@ -206,6 +207,15 @@ class FsiCoupling final : public Module {
   Eigen::Index bodyOffset_ = 0;  ///< the free coordinates of the rigid system in the interface vector
   std::vector<RigidPlacement> transforms_;  ///< per coupled body: its motion at the iterate being placed
   std::unique_ptr<coupling::MeshSmoother> smoother_;
+  /// meshMotion.bodies: the bodies' distance-weighted rigid motion in the mesh (the smoother's base),
+  /// the coupled-body slot of each of its bodies, and the field.
+  struct Reach {
+    coupling::RigidBlend blend;
+    std::vector<int> slot;
+    Real3View base;
+    std::vector<RigidPlacement> transforms;
+  };
+  Reach reach_;
   std::unique_ptr<coupling::Acceleration> acceleration_;
   Eigen::Index size_ = 0;
   double stepEnd_ = 0;  ///< t_n+1 of the step being solved
