@@ -133,12 +133,25 @@ void ParentFrames::setAccelerations(const std::vector<BodyAcceleration>& acceler
 
 void ParentFrames::inertialForce(const ExecSpace& exec, const ConstReal3View& x, const ConstRealView& relativeVelocity,
                                  const ConstRealView& mass, const Real3View& f) const {
+  frameInertia(exec, x, relativeVelocity, ConstRealView(), mass, f);
+}
+
+void ParentFrames::relativeInertia(const ExecSpace& exec, const ConstRealView& relativeVelocity,
+                                   const ConstRealView& relativeAcceleration, const ConstRealView& mass,
+                                   const Real3View& f) const {
+  frameInertia(exec, ConstReal3View(), relativeVelocity, relativeAcceleration, mass, f);
+}
+
+void ParentFrames::frameInertia(const ExecSpace& exec, const ConstReal3View& x, const ConstRealView& relativeVelocity,
+                                const ConstRealView& relativeAcceleration, const ConstRealView& mass,
+                                const Real3View& f) const {
   MFSI_CHECK(accelerations_.extent(0) == static_cast<std::size_t>(nBodies_),
-             "parent frames: inertialForce before setAccelerations");
+             "parent frames: inertial forces before setAccelerations");
   const auto W = weights_;
   const auto A = accelerations_;
   const auto F = frames_;
   const int nb = nBodies_;
+  const bool carried = relativeAcceleration.extent(0) == 0;
   Kokkos::parallel_for(
       "mfsi::coupling::parentFrames::inertialForce", RangePolicy(exec, 0, static_cast<lid_t>(weights_.extent(0))),
       KOKKOS_LAMBDA(lid_t i) {
@@ -146,18 +159,28 @@ void ParentFrames::inertialForce(const ExecSpace& exec, const ConstReal3View& x,
         for (int b = 0; b < nb; ++b) {
           const real w = W(i, b);
           if (w == 0) continue;
-          const real r[3] = {x(i, 0) - A(b, 0), x(i, 1) - A(b, 1), x(i, 2) - A(b, 2)};
-          const real o[3] = {A(b, 6), A(b, 7), A(b, 8)}, al[3] = {A(b, 9), A(b, 10), A(b, 11)};
+          const real o[3] = {A(b, 6), A(b, 7), A(b, 8)};
           real v[3];  // the relative velocity in world axes: Q v, (Q v)_j = sum_k Q_jk v_k
           for (int j = 0; j < 3; ++j)
             v[j] = F(b, 6 + 3 * j) * relativeVelocity(3 * i) + F(b, 7 + 3 * j) * relativeVelocity(3 * i + 1) +
                    F(b, 8 + 3 * j) * relativeVelocity(3 * i + 2);
-          real oxr[3], axr[3], ooxr[3], oxv[3];  // omega x r, alpha x r, omega x (omega x r), omega x v
-          geom::cross(o, r, oxr);
-          geom::cross(al, r, axr);
-          geom::cross(o, oxr, ooxr);
+          real oxv[3];  // omega x v: the Coriolis term, in both
           geom::cross(o, v, oxv);
-          for (int k = 0; k < 3; ++k) acc[k] += w * (A(b, 3 + k) + axr[k] + ooxr[k] + 2 * oxv[k]);
+          for (int k = 0; k < 3; ++k) acc[k] += w * 2 * oxv[k];
+          if (carried) {
+            const real r[3] = {x(i, 0) - A(b, 0), x(i, 1) - A(b, 1), x(i, 2) - A(b, 2)};
+            const real al[3] = {A(b, 9), A(b, 10), A(b, 11)};
+            real oxr[3], axr[3], ooxr[3];  // omega x r, alpha x r, omega x (omega x r)
+            geom::cross(o, r, oxr);
+            geom::cross(al, r, axr);
+            geom::cross(o, oxr, ooxr);
+            for (int k = 0; k < 3; ++k) acc[k] += w * (A(b, 3 + k) + axr[k] + ooxr[k]);
+          } else {
+            for (int k = 0; k < 3; ++k)  // Q a
+              acc[k] += w * (F(b, 6 + 3 * k) * relativeAcceleration(3 * i) +
+                             F(b, 7 + 3 * k) * relativeAcceleration(3 * i + 1) +
+                             F(b, 8 + 3 * k) * relativeAcceleration(3 * i + 2));
+          }
         }
         for (int k = 0; k < 3; ++k) f(i, k) = -mass(i) * acc[k];
       });

@@ -14,7 +14,8 @@
 /// blend keeps a membrane spanning two independently moving bodies continuous (nearest-body
 /// frames would tear it where the nearest body changes). The fluid's load on a mounted membrane is
 /// passed on to its parents, each element's share by its nodes' weights; nodal forces (the viscous
-/// traction, the inertia of the membrane's mass carried by the accelerating frames) likewise, each
+/// traction, the inertia of the membrane's mass carried by the accelerating frames, the reaction
+/// of its motion relative to them) likewise, each
 /// node's by its weights, and they reach the frame-relative FEM rotated into the frames
 /// (sum_b w_b Q_b^T f).
 #include "core/Types.hpp"
@@ -57,14 +58,23 @@ class ParentFrames {
     std::array<double, 3> centre{0, 0, 0}, acceleration{0, 0, 0}, omega{0, 0, 0}, alpha{0, 0, 0};
   };
   void setAccelerations(const std::vector<BodyAcceleration>& accelerations);
+  bool hasAccelerations() const { return accelerations_.extent(0) == static_cast<std::size_t>(nBodies_) && nBodies_ > 0; }
   /// f(i) = -m_i sum_b w_ib (a_b + alpha_b x r + omega_b x (omega_b x r) + 2 omega_b x Q_b v_i),
   /// r = x_i - c_b: the inertial force of node i (lumped mass m_i, position x_i, velocity v_i
   /// relative to its frames, in frame axes, 3 per node) carried along by its frames, with the
   /// Coriolis term of its motion relative to them. The FEM, solved relative to the frames, takes
-  /// it as a load, and the bodies take it back as the membrane's inertia on them (their share of
-  /// the relative acceleration itself, m_i d2u/dt2, is left out).
+  /// it as a load; the bodies carry the nodes' masses (their rigid motion's share).
   void inertialForce(const ExecSpace& exec, const ConstReal3View& x, const ConstRealView& relativeVelocity,
                      const ConstRealView& mass, const Real3View& f) const;
+  /// f(i) = -m_i sum_b w_ib (Q_b a_i + 2 omega_b x Q_b v_i) (world axes): the inertia of node i's
+  /// motion relative to its frames (a_i, v_i its relative acceleration and velocity in frame
+  /// axes, 3 per node), what the bodies receive from the membrane on top of the mass they carry:
+  /// a panel that swings in its frame pushes the frame back.
+  void relativeInertia(const ExecSpace& exec, const ConstRealView& relativeVelocity,
+                       const ConstRealView& relativeAcceleration, const ConstRealView& mass, const Real3View& f) const;
+  /// Both: `relativeAcceleration` empty gives inertialForce's terms, else relativeInertia's (x unused).
+  void frameInertia(const ExecSpace& exec, const ConstReal3View& x, const ConstRealView& relativeVelocity,
+                    const ConstRealView& relativeAcceleration, const ConstRealView& mass, const Real3View& f) const;
 
   /// relative(i) = sum_b w_ib Q_b^T global(i): nodal forces into the frames the FEM is solved in.
   void toFrames(const ExecSpace& exec, const ConstReal3View& global, const Real3View& relative) const;

@@ -408,8 +408,9 @@ void FsiCoupling::setUpParents(const SceneConfig& section) {
       p.forceFrame = Real3View("mfsi::coupling::nodeForceInFrames", n);
       p.module->solver().loads().nodeForce = p.forceFrame;
     }
-    if (options_.viscousTraction) p.nodePosition = Real3View("mfsi::coupling::mountedNodePosition", n);
+    if (options_.viscousTraction || p.dynamic) p.nodePosition = Real3View("mfsi::coupling::mountedNodePosition", n);
     if (p.dynamic) {
+      p.reaction = Real3View("mfsi::coupling::relativeInertia", n);
       p.inertia = Real3View("mfsi::coupling::frameInertia", n);
       p.framePosition = Real3View("mfsi::coupling::framePosition", n);
       if (options_.viscousTraction) p.nodeLoad = Real3View("mfsi::coupling::mountedNodeLoad", n);
@@ -474,7 +475,7 @@ void FsiCoupling::advanceLoadFilter() {
   }
 }
 
-void FsiCoupling::updateLoads(double scale, bool relax, double dt) {
+void FsiCoupling::updateLoads(double scale, bool relax, double dt, bool stepStart) {
   ScopedTimer timer(timers_, "coupling.transfer");
   const fluid::FluidSolver& f = fluid_->solver();
   double change2 = 0, norm2 = 0;
@@ -522,7 +523,7 @@ void FsiCoupling::updateLoads(double scale, bool relax, double dt) {
     // both before each structure solve.
     if (p.mounted && !p.dynamic) p.parents.toFrames(exec_, p.force, p.forceFrame);
   }
-  updateBodyLoads(scale);
+  updateBodyLoads(scale, stepStart);
   const SolverComm comm;
   change2 = comm.globalSum(change2);
   norm2 = comm.globalSum(norm2);
@@ -578,41 +579,51 @@ void FsiCoupling::updateFrameInertia() {
   }
 }
 
-void FsiCoupling::updateBodyLoads(double scale) {
+void FsiCoupling::updateBodyLoads(double scale, bool stepStart) {
   if (bodies_.empty()) return;
   const fluid::FluidSolver& f = fluid_->solver();
   RigidBodySystem& sys = rigid_->system();
+  // Mounted membranes: the nodes' positions (the levers of nodal forces) and, for a dynamic one,
+  // the reaction of its motion relative to the frames: at the step's start from the committed
+  // state of membranes and bodies (what a restart has too), in an iteration from the trial state
+  // at the iterate.
+  if (stepStart) updateFrameInertia();
+  for (Panel& p : panels_) {
+    if (!p.mounted || p.nodePosition.extent(0) == 0) continue;
+    MembraneSolver& s = p.module->solver();
+    p.parents.positions(exec_, s.mesh().referencePoints(), stepStart ? s.displacement() : p.iterate, p.nodePosition);
+    if (p.dynamic && p.parents.hasAccelerations())
+      p.parents.relativeInertia(exec_, stepStart ? s.velocity() : s.trialVelocity(),
+                                stepStart ? s.acceleration() : s.trialAcceleration(), s.nodalMass(), p.reaction);
+  }
   for (std::size_t slot = 0; slot < bodies_.size(); ++slot) {
     const CoupledBody& b = bodies_[slot];
     // Force and moment about the body's centre of mass in its latest state.
     const Eigen::Vector3d c = sys.bodyReport(b.index).position;
     Eigen::Vector3d force = Eigen::Vector3d::Zero(), moment = Eigen::Vector3d::Zero();
-    for (const auto& patch : b.patches) {
-      const fluid::PatchLoads L = fluid::patchLoads(f, patch, {c[0], c[1], c[2]});
-      for (int k = 0; k < 3; ++k) {
-        force[k] += scale * L.force[k];
-        moment[k] += scale * L.moment[k];
-      }
-    }
-    // Mounted membranes pass their load (already scaled and relaxed) on to their bodies.
-    for (const Panel& p : panels_) {
-      if (!p.mounted) continue;
-      const std::array<double, 6> L = p.parents.bodyLoad(
-          exec_, static_cast<int>(slot), {c[0], c[1], c[2]}, p.module->solver().mesh().elementNodes(), p.load,
-          p.iface.front, 0, p.surface.faceArea(), p.surface.faceCentroid());
+    auto add = [&](const std::array<double, 6>& L) {
       for (int k = 0; k < 3; ++k) {
         force[k] += L[k];
         moment[k] += L[3 + k];
       }
-      if (!options_.viscousTraction) continue;
+    };
+    for (const auto& patch : b.patches) {
+      const fluid::PatchLoads L = fluid::patchLoads(f, patch, {c[0], c[1], c[2]});
+      add({scale * L.force[0], scale * L.force[1], scale * L.force[2], scale * L.moment[0], scale * L.moment[1],
+           scale * L.moment[2]});
+    }
+    // Mounted membranes pass their load (already scaled and relaxed) on to their bodies.
+    for (const Panel& p : panels_) {
+      if (!p.mounted) continue;
+      const int s = static_cast<int>(slot);
+      add(p.parents.bodyLoad(exec_, s, {c[0], c[1], c[2]}, p.module->solver().mesh().elementNodes(), p.load,
+                             p.iface.front, 0, p.surface.faceArea(), p.surface.faceCentroid()));
       // The viscous nodal forces (relaxed, as the membrane receives them) at the nodes' positions.
-      p.parents.positions(exec_, p.module->solver().mesh().referencePoints(), p.iterate, p.nodePosition);
-      const std::array<double, 6> V = p.parents.nodeLoad(exec_, static_cast<int>(slot), {c[0], c[1], c[2]},
-                                                         p.nodePosition, p.force);
-      for (int k = 0; k < 3; ++k) {
-        force[k] += V[k];
-        moment[k] += V[3 + k];
-      }
+      if (options_.viscousTraction) add(p.parents.nodeLoad(exec_, s, {c[0], c[1], c[2]}, p.nodePosition, p.force));
+      // The reaction of the membrane's motion relative to the frames (its mass's share of the
+      // frames' own motion is in the bodies' inertia).
+      if (p.dynamic && p.parents.hasAccelerations())
+        add(p.parents.nodeLoad(exec_, s, {c[0], c[1], c[2]}, p.nodePosition, p.reaction));
     }
     sys.setExternalLoad(b.index, force, moment);
   }
@@ -821,7 +832,7 @@ void FsiCoupling::advance(const TimeState& t) {
     p.module->solver().discardStep();
   }
   const double scale = loadScale(t1);
-  updateLoads(scale, false, t.dt);  // the loads of the fluid at t_n (the structure goes first)
+  updateLoads(scale, false, t.dt, true);  // the loads of the fluid at t_n (the structure goes first)
   if (options_.extrapolatedPredictor) extrapolateLoads();
   InterfaceVector x(size_), xt(size_), good(size_);
   for (const Panel& p : panels_) toHost(p.module->solver().displacement(), good, p.offset);  // the mesh is there

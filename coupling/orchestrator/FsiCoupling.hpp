@@ -125,6 +125,7 @@ class FsiCoupling final : public Module {
     Real3View inertia;       ///< mounted, dynamic: the frames' acceleration on the nodes' masses (world axes)
     Real3View framePosition;  ///< mounted, dynamic: the nodes' positions at the step's start (inertia's lever)
     Real3View nodeLoad;      ///< mounted, dynamic, viscous traction: viscous force + inertia (world axes)
+    Real3View reaction;      ///< mounted, dynamic: the inertia of the motion relative to the frames (world axes), on the bodies
     Real3View faceVelocity;
     RealView iterate;  ///< this panel's slice of an interface iterate on the device (3 per node)
     Eigen::Index offset = 0;
@@ -147,12 +148,14 @@ class FsiCoupling final : public Module {
     Eigen::Matrix3d rotation0 = Eigen::Matrix3d::Identity();
   };
   /// Membrane loads from the fluid (times `scale`); with `relax`, forceOmega-blended with the
-  /// previous ones. Sets the load residual.
-  void updateLoads(double scale, bool relax, double dt);
+  /// previous ones. Sets the load residual. `stepStart`: the loads of t_n, before the step's first
+  /// structure solve (the bodies' share from the committed state).
+  void updateLoads(double scale, bool relax, double dt, bool stepStart = false);
   /// The filter state of pNetFilterTau advances to the step's last load.
   void advanceLoadFilter();
-  /// The fluid's force and moment on each coupled body's patches (times `scale`) become its external load.
-  void updateBodyLoads(double scale);
+  /// The fluid's force and moment on each coupled body's patches (times `scale`) and its mounted
+  /// membranes' loads and relative inertia become its external load.
+  void updateBodyLoads(double scale, bool stepStart);
   /// Mounted dynamic membranes: the inertial force of their mass carried by the bodies' current
   /// accelerations (Panel::inertia), and the FEM's nodal load in the frames (viscous + inertia).
   /// extrapolatedPredictor: each panel's load becomes 2 p_n - p_n-1 (p_n kept for the next step).

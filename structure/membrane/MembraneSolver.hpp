@@ -96,6 +96,7 @@ class MembraneSolver {
   /// Trial state at time() + dt of the last `solveStep` (3 per node).
   RealView trialDisplacement() const { return uTrial_; }
   RealView trialVelocity() const { return v1_; }
+  RealView trialAcceleration() const { return a1_; }
   /// \brief Replace the trial displacement (a relaxed FSI update); the trial velocity and
   /// acceleration follow from the integrator's relations.
   void setTrialDisplacement(const ConstRealView& u1);

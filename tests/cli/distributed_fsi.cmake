@@ -6,8 +6,10 @@
 #   bit for bit (steps.csv without the wall time).
 # - The piston (a rigid body, added mass 100 x its own): the force and acceleration on 2 ranks to
 #   1e-9 (fsiTol 1e-13; the iteration count may differ by rank count at that level).
-# - The membrane channel (two baffle membranes mounted on a sliding rigid frame): the frame's and
-#   bar's forces on 2 ranks to 1e-9, the panel's centre displacement (1e-9 m) to 1e-7.
+# - The membrane channel (two baffle membranes mounted on a sliding rigid frame): the bar's force
+#   on 2 ranks to 1e-9; the frame's, which carries the panels' inertia relative to it (their
+#   accelerations: the displacement's differences times 4 / dt^2), to 1e-8 (measured 1.4e-9); the
+#   panel's centre displacement (1e-9 m) to 1e-7.
 # - The balloon (a closed chamber: a membrane with a volume constraint) to t = 2 s: on 2 ranks the
 #   membrane's centre displacement to 1e-8, the chamber's volume to 1e-10 and its pressure (the
 #   multiplier plus the fluid's mean load) to 1e-6 of one rank's (measured 1.4e-10, 2e-13, 5e-8).
@@ -111,7 +113,8 @@ same(piston1 piston2 1e-9 bodies.body.piston.Fx bodies.body.piston.ax)
 set(channel membrane-channel --set time.endTime=0.06 --set mesh.blocks.0.cells=[24,8,16] ${tight})
 run(channel1 1 ${channel})
 run(channel2 2 ${channel})
-same(channel1 channel2 1e-9 fluid.bar.force_x bodies.body.frame.Fx fluid.max_velocity)
+same(channel1 channel2 1e-9 fluid.bar.force_x fluid.max_velocity)
+same(channel1 channel2 1e-8 bodies.body.frame.Fx)
 same(channel1 channel2 1e-7 membrane.panelA.centreUx membrane.panelB.centreUx)
 
 if(SHORT)

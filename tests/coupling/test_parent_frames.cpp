@@ -109,14 +109,25 @@ TEST(ParentFrames, ABlendedNodeSharesItsForce) {
 // alpha x r = (0, 0.5, 0), omega x (omega x r) = (-4, 0, 0), so f = -2 (-3, 2.5, 3). Moving at
 // v = (1, 0, 0) in frame axes, Q v = (0, 1, 0) and the Coriolis term 2 omega x Q v = (-4, 0, 0) adds
 // 8 to f_x.
-TEST(ParentFrames, InertialForceWithCoriolis) {
+namespace {
+/// One node at (1, 0, 0) on a frame turned by 90 degrees about z (centre of mass at the origin),
+/// accelerating: a = (1, 2, 3), omega = (0, 0, 2), alpha = (0, 0, 0.5).
+cpl::ParentFrames acceleratingTurnedFrame() {
   cpl::ParentFrames pf({{1, 0, 0}}, {{0, 0, 0}}, {0}, 1);
   pf.setTransforms({mfsi::RigidPlacement::rotationAbout({0, 0, 1}, kPi / 2, {0, 0, 0})});
+  EXPECT_FALSE(pf.hasAccelerations());
   cpl::ParentFrames::BodyAcceleration acc;
   acc.acceleration = {1, 2, 3};
   acc.omega = {0, 0, 2};
   acc.alpha = {0, 0, 0.5};
   pf.setAccelerations({acc});
+  EXPECT_TRUE(pf.hasAccelerations());
+  return pf;
+}
+}  // namespace
+
+TEST(ParentFrames, InertialForceWithCoriolis) {
+  const cpl::ParentFrames pf = acceleratingTurnedFrame();
   const mfsi::ExecSpace exec;
   const auto x = points({{1, 0, 0}});
   mfsi::RealView mass("test::mass", 1), v("test::v", 3);
@@ -132,4 +143,27 @@ TEST(ParentFrames, InertialForceWithCoriolis) {
     const double expect[3] = {6 + 8 * vx, -5, -6};
     for (int k = 0; k < 3; ++k) EXPECT_TRUE(near(hf(0, k), expect[k], Tol{1e-13, 0}, "f, v = " + std::to_string(vx)));
   }
+}
+
+// What the bodies receive from the same node moving in its frame: -m (Q a + 2 omega x Q v), the
+// frame turned by 90 degrees about z (Q (1, 0, 0) = (0, 1, 0), Q (0, 1, 0) = (-1, 0, 0)), omega =
+// (0, 0, 2), m = 2. With a = (0, 1, 3) and v = (1, 0, 0) in frame axes: Q a = (-1, 0, 3), Q v =
+// (0, 1, 0), 2 omega x Q v = (-4, 0, 0), so f = -2 (-5, 0, 3). The frames' own acceleration and
+// the lever terms (what the mass the bodies carry already answers) are not in it.
+TEST(ParentFrames, RelativeInertiaOnTheBodies) {
+  const cpl::ParentFrames pf = acceleratingTurnedFrame();
+  const mfsi::ExecSpace exec;
+  mfsi::RealView mass("test::mass", 1), v("test::v", 3), a("test::a", 3);
+  Kokkos::deep_copy(mass, 2.0);
+  auto hv = Kokkos::create_mirror_view(v);
+  auto ha = Kokkos::create_mirror_view(a);
+  hv(0) = 1, hv(1) = 0, hv(2) = 0;
+  ha(0) = 0, ha(1) = 1, ha(2) = 3;
+  Kokkos::deep_copy(v, hv);
+  Kokkos::deep_copy(a, ha);
+  mfsi::Real3View f("test::f", 1);
+  pf.relativeInertia(exec, v, a, mass, f);
+  auto hf = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), f);
+  const double expect[3] = {10, 0, -6};
+  for (int k = 0; k < 3; ++k) EXPECT_TRUE(near(hf(0, k), expect[k], Tol{1e-13, 0}, "f"));
 }
