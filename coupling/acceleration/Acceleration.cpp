@@ -63,6 +63,7 @@ std::unique_ptr<Acceleration> makeAcceleration(const AccelerationOptions& option
   if (options.method == AccelerationMethod::IqnIls || options.iqnMaxCols > 0) {
     AccelerationOptions o = options;
     o.method = AccelerationMethod::IqnIls;
+    if (o.iqnJacobian == IqnJacobian::MultiVector) return std::make_unique<IqnImvj>(o, std::move(layout), comm);
     return std::make_unique<IqnIls>(o, std::move(layout), comm);
   }
   if (options.method == AccelerationMethod::Aitken) return std::make_unique<Aitken>(options, std::move(layout), comm);

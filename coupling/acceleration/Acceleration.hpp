@@ -38,6 +38,15 @@ enum class AccelerationMethod {
   IqnIls,    ///< interface quasi-Newton, inverse Jacobian by least squares (Degroote et al. 2009)
 };
 
+/// The inverse Jacobian a quasi-Newton method (iqnMaxCols > 0) builds.
+enum class IqnJacobian {
+  LeastSquares,  ///< IQN-ILS: W V^+ from the history alone (columns of past steps by iqnReuseCols)
+  /// IQN-IMVJ (Lindner, Mehl & Uekermann 2015): the last step's whole inverse Jacobian J_prev,
+  /// updated by this step's history, J = J_prev + (W - J_prev V) V^+: what past steps learnt is
+  /// kept beyond the reused columns, and the step's first pass is already a quasi-Newton step.
+  MultiVector,
+};
+
 /// \brief Options of the `coupling` section (the seed's names; `mfsi check --describe` documents them).
 struct AccelerationOptions {
   AccelerationMethod method = AccelerationMethod::Aitken;
@@ -45,6 +54,7 @@ struct AccelerationOptions {
   double omegaMin = 0.05;  ///< Aitken's lower bound on omega
   int iqnMaxCols = 0;      ///< most history columns IQN-ILS keeps (> 0 selects IQN-ILS)
   int iqnReuseCols = 0;    ///< past time steps whose columns IQN-ILS keeps (0: history reset each step)
+  IqnJacobian iqnJacobian = IqnJacobian::LeastSquares;
   /// QR2 filter: a column whose part orthogonal to the newer ones is below iqnFilterEps times its
   /// norm is dropped (it adds nothing but ill-conditioning).
   double iqnFilterEps = 1e-2;

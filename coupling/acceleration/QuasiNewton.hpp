@@ -59,6 +59,12 @@ class QuasiNewton : public Acceleration {
   InterfaceVector scaled(const InterfaceVector& a) const;
   /// A relaxation step x <- x + omega r (Aitken's omega, or omegaInit without history).
   void relax(const InterfaceVector& r, InterfaceVector& x, AccelerationReport& report);
+  /// IQN-ILS's alpha = argmin |S (V alpha + r)| on the current factorisation.
+  Eigen::VectorXd coefficients(const InterfaceVector& r) const;
+  /// x <- next, a quasi-Newton step with `columns` columns, unless the step-size limiter rejects it
+  /// (non-finite, or beyond maxUpdate): then a relaxation step.
+  void accept(const InterfaceVector& next, const InterfaceVector& r, int columns, InterfaceVector& x,
+              AccelerationReport& report);
 
   std::deque<Column> columns_;
   AitkenOmega aitken_;
@@ -88,6 +94,34 @@ class IqnIls final : public QuasiNewton {
  protected:
   void step(const InterfaceVector& xt, const InterfaceVector& r, InterfaceVector& x,
             AccelerationReport& report) override;
+};
+
+/// \brief IQN-IMVJ (Lindner, Mehl & Uekermann 2015): x <- xt - J_prev r + (W - J_prev V) alpha with
+/// alpha the least-squares coefficients of IQN-ILS and J_prev the inverse Jacobian of the previous
+/// steps, J_prev <- J_prev + (W - J_prev V) V^+ at each step's end (V^+ = R^-1 Q^T S: J V = W on
+/// every kept column, reused ones included). J_prev starts as (1 - omegaInit) I, a relaxation by
+/// omegaInit in every direction no history has seen, so the first pass of the first step is the
+/// relaxation step of IQN-ILS. J_prev is a dense n x n matrix on one rank: for interfaces of up to
+/// kMaxUnknowns unknowns.
+class IqnImvj final : public QuasiNewton {
+ public:
+  static constexpr Eigen::Index kMaxUnknowns = 20000;
+  /// Throws InputError past kMaxUnknowns or on more than one rank.
+  IqnImvj(const AccelerationOptions& options, std::vector<InterfaceBlock> layout, const SolverComm& comm);
+  void endStep() override;
+  void saveState(io::StateWriter& w) const override;
+  void loadState(const io::StateReader& r) override;
+  /// The inverse Jacobian carried between steps. For tests.
+  const Eigen::MatrixXf& jacobian() const { return jPrev_; }
+
+ protected:
+  void step(const InterfaceVector& xt, const InterfaceVector& r, InterfaceVector& x,
+            AccelerationReport& report) override;
+
+ private:
+  /// Single precision: the matrix-vector product of every pass reads n^2 values (memory-bound), and
+  /// the Jacobian is a model; the fixed point is judged on the residual, in double.
+  Eigen::MatrixXf jPrev_;
 };
 
 }  // namespace mfsi::coupling

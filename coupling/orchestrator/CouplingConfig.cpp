@@ -94,6 +94,12 @@ Schema couplingSchema() {
            Default(a.iqnMaxCols))
       .key("iqnReuseCols", Schema::integer("past time steps whose IQN-ILS columns are reused").atLeast(0),
            Default(a.iqnReuseCols))
+      .key("iqnJacobian",
+           Schema::choice("the inverse Jacobian of the quasi-Newton method: leastSquares (IQN-ILS, from the history "
+                          "alone) or multiVector (IQN-IMVJ: the previous steps' Jacobian updated by this step's "
+                          "history; dense, one rank)",
+                          {"leastSquares", "multiVector"}),
+           Default("leastSquares"))
       .key("iqnFilter",
            Schema::real("QR2 filter: drop a column whose new part is below this fraction of its norm", "-")
                .atLeast(0)
@@ -212,6 +218,9 @@ CouplingOptions readCouplingOptions(const SceneConfig& c) {
   a.omegaMin = c.get<double>("omegaMin");
   a.iqnMaxCols = c.get<int>("iqnMaxCols");
   a.iqnReuseCols = c.get<int>("iqnReuseCols");
+  a.iqnJacobian = c.get<std::string>("iqnJacobian") == "multiVector" ? coupling::IqnJacobian::MultiVector
+                                                                      : coupling::IqnJacobian::LeastSquares;
+
   a.iqnFilterEps = c.get<double>("iqnFilter");
   a.maxUpdate = c.get<double>("iqnMaxUpdate");
   a.stallIterations = c.get<int>("stallIterations");

@@ -885,7 +885,10 @@ void FsiCoupling::advance(const TimeState& t) {
     if (limitUpdate(x, previous, t.dt)) ++last_.limited;
     setTrial(x);
   }
-  acceleration_->endStep();
+  {
+    ScopedTimer timer(timers_, "coupling.acceleration");  // IQN-IMVJ updates its Jacobian here
+    acceleration_->endStep();
+  }
   // Converged (or explicit): the structure's last answer is committed; the fluid saw the mesh at x,
   // within fsiTol of it. Not converged: the last relaxed iterate, which the mesh and fluid match.
   if (!last_.converged && implicit) setTrial(x);
