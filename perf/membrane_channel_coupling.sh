@@ -20,6 +20,7 @@ scene=$repo/cases/membrane-channel.yaml
 run() {  # name, --set arguments...
   local name=$1
   shift
+  rm -rf "${work:?}/$name"  # a failed run must not leave an earlier run's results to be read
   "$mfsi" run "$scene" "$@" --out "$work/$name" --threads "$threads" > "$work/$name.log" 2>&1 || true
 }
 run reference --set coupling.fsiTol=1.0e-7 --set coupling.maxFsiIter=60
@@ -31,7 +32,10 @@ tmp=$(mktemp "$out.XXXX")
 import csv, json, sys
 work, rev, threads = sys.argv[1], sys.argv[2], sys.argv[3]
 def load(name):
-    s = json.load(open(f"{work}/{name}/summary.json"))
+    try:
+        s = json.load(open(f"{work}/{name}/summary.json"))
+    except OSError:
+        return {"status": "failed", "frame_dx": float("nan"), "wall_s": float("nan"), "metrics": {}}
     rows = list(csv.DictReader(open(f"{work}/{name}/bodies.csv")))
     s["frame_dx"] = float(rows[-1]["x"]) - float(rows[0]["x"]) if s["status"] == "ok" else float("nan")
     return s

@@ -34,6 +34,7 @@ for ratio in 10 1 0.1 0.01; do
       explicit) extra=(--set coupling.scheme=explicit) ;;
     esac
     dir=$work/${mode}_$ratio
+    rm -rf "${dir:?}"  # a failed run must not leave an earlier run's results to be read
     "$mfsi" run "$repo/cases/piston.yaml" --set bodies.members.piston.mass=$m --set time.dt=$($py -c "print($T / 100)") \
       --set time.endTime=$($py -c "print(3 * $T)") "${extra[@]}" --out "$dir" --threads 2 > "$dir.log" 2>&1 || true
     $py - "$dir" "$ratio" "$mode" "$T" >> "$tmp" <<'PY'
