@@ -182,10 +182,63 @@ std::string csvHeader(const std::vector<std::string>& columns) {
 }
 }  // namespace
 
-StepLog::StepLog(const std::string& path, std::vector<std::string> columns) : path_(path), nColumns_(columns.size()) {
-  writeTextAtomically(path, csvHeader(columns) + "\n");  // never a cut-off header
-  openForAppend();
+AppendFile AppendFile::create(const std::string& path, const std::string& header) {
+  writeTextAtomically(path, header);
+  return open(path);
 }
+
+AppendFile AppendFile::open(const std::string& path) {
+  AppendFile f;
+  f.path_ = path;
+  f.fd_ = ::open(path.c_str(), O_WRONLY | O_APPEND | O_CLOEXEC);
+  struct stat st {};
+  if (f.fd_ < 0 || ::fstat(f.fd_, &st) != 0) {
+    const int err = errno;
+    f.close();
+    throw OutputError("cannot open '" + path + "' to append: " + std::strerror(err));
+  }
+  f.written_ = static_cast<long long>(st.st_size);
+  return f;
+}
+
+AppendFile::AppendFile(AppendFile&& o) noexcept : path_(std::move(o.path_)), fd_(o.fd_), written_(o.written_) {
+  o.fd_ = -1;
+}
+
+AppendFile& AppendFile::operator=(AppendFile&& o) noexcept {
+  if (this != &o) {
+    close();
+    path_ = std::move(o.path_);
+    fd_ = o.fd_;
+    written_ = o.written_;
+    o.fd_ = -1;
+  }
+  return *this;
+}
+
+AppendFile::~AppendFile() { close(); }
+
+void AppendFile::close() noexcept {
+  if (fd_ >= 0) ::close(fd_);
+  fd_ = -1;
+}
+
+void AppendFile::append(const std::string& text) {
+  if (fd_ < 0) throw OutputError("cannot write '" + path_ + "': an earlier write failed");
+  if (writeAll(fd_, text.data(), text.size())) {
+    written_ += static_cast<long long>(text.size());
+    return;
+  }
+  // Keep whole records: cut off what the failed write left of this one (shrinking a file needs no
+  // space), and take no more.
+  const int err = errno;
+  const bool cut = ::ftruncate(fd_, static_cast<off_t>(written_)) == 0;
+  close();
+  throw OutputError(writeFailure(path_, err) + (cut ? "" : "; its last row may be cut short"));
+}
+
+StepLog::StepLog(const std::string& path, std::vector<std::string> columns)
+    : file_(AppendFile::create(path, csvHeader(columns) + "\n")), nColumns_(columns.size()) {}
 
 void keepCsvRows(const std::string& path, const std::string& header, long long rows) {
   std::ifstream in(path);
@@ -206,64 +259,18 @@ void keepCsvRows(const std::string& path, const std::string& header, long long r
 }
 
 StepLog::StepLog(const std::string& path, std::vector<std::string> columns, long long keepRows)
-    : path_(path), nColumns_(columns.size()) {
+    : nColumns_(columns.size()) {
   keepCsvRows(path, csvHeader(columns), keepRows);
-  openForAppend();
-}
-
-StepLog::StepLog(StepLog&& o) noexcept
-    : path_(std::move(o.path_)), fd_(o.fd_), written_(o.written_), nColumns_(o.nColumns_) {
-  o.fd_ = -1;
-}
-
-StepLog& StepLog::operator=(StepLog&& o) noexcept {
-  if (this != &o) {
-    close();
-    path_ = std::move(o.path_);
-    fd_ = o.fd_;
-    written_ = o.written_;
-    nColumns_ = o.nColumns_;
-    o.fd_ = -1;
-  }
-  return *this;
-}
-
-StepLog::~StepLog() { close(); }
-
-void StepLog::close() noexcept {
-  if (fd_ >= 0) ::close(fd_);
-  fd_ = -1;
-}
-
-void StepLog::openForAppend() {
-  fd_ = ::open(path_.c_str(), O_WRONLY | O_APPEND | O_CLOEXEC);
-  struct stat st {};
-  if (fd_ < 0 || ::fstat(fd_, &st) != 0) {
-    const int err = errno;
-    close();
-    throw OutputError("cannot open '" + path_ + "' to append: " + std::strerror(err));
-  }
-  written_ = static_cast<long long>(st.st_size);
+  file_ = AppendFile::open(path);
 }
 
 void StepLog::row(const std::vector<double>& values) {
   MFSI_ASSERT(values.size() == nColumns_, "step log row has " << values.size() << " values for " << nColumns_);
-  if (fd_ < 0) throw OutputError("cannot write '" + path_ + "': an earlier write failed");
   std::ostringstream line;
   line << std::setprecision(12);
   for (std::size_t i = 0; i < values.size(); ++i) line << (i ? "," : "") << values[i];
   line << "\n";
-  const std::string text = line.str();
-  if (writeAll(fd_, text.data(), text.size())) {
-    written_ += static_cast<long long>(text.size());
-    return;
-  }
-  // Keep whole rows: cut off what the failed write left of this one (shrinking a file needs no
-  // space), and take no more rows.
-  const int err = errno;
-  const bool cut = ::ftruncate(fd_, static_cast<off_t>(written_)) == 0;
-  close();
-  throw OutputError(writeFailure(path_, err) + (cut ? "" : "; its last row may be cut short"));
+  file_.append(line.str());
 }
 
 bool stdoutIsTerminal() { return ::isatty(STDOUT_FILENO) == 1; }

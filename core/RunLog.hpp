@@ -58,6 +58,34 @@ std::string jsonEscape(const std::string& s);
 /// Throws InputError naming the file when it is missing, has another header or fewer rows.
 void keepCsvRows(const std::string& path, const std::string& header, long long rows);
 
+/// \brief A text file appended to in whole records (the rows of `steps.csv`, `bodies.csv`): each
+/// `append` is one write, and when one fails the file is cut back to the records before it and
+/// takes no more, so a full disk never leaves half a row that looks like data.
+class AppendFile {
+ public:
+  AppendFile() = default;
+  /// A new file holding `header` (written atomically: never a cut-off header), open to append.
+  static AppendFile create(const std::string& path, const std::string& header);
+  /// An existing file, open to append after what it holds. Throws OutputError when it cannot.
+  static AppendFile open(const std::string& path);
+  AppendFile(AppendFile&& other) noexcept;
+  AppendFile& operator=(AppendFile&& other) noexcept;
+  AppendFile(const AppendFile&) = delete;
+  AppendFile& operator=(const AppendFile&) = delete;
+  ~AppendFile();
+  /// Append `text` in one write. Throws OutputError naming the file when the write fails (or an
+  /// earlier one did); the file then keeps exactly what it held before.
+  void append(const std::string& text);
+  bool isOpen() const { return fd_ >= 0; }
+
+ private:
+  void close() noexcept;
+
+  std::string path_;
+  int fd_ = -1;            ///< the file, opened to append
+  long long written_ = 0;  ///< its size: what was written whole
+};
+
 class StepLog {
  public:
   StepLog() = default;
@@ -66,24 +94,14 @@ class StepLog {
   /// `keepRows` rows (the steps up to the checkpoint), drop the later ones, append from there.
   /// Throws InputError when the file is missing, has other columns or fewer rows.
   StepLog(const std::string& path, std::vector<std::string> columns, long long keepRows);
-  StepLog(StepLog&& other) noexcept;
-  StepLog& operator=(StepLog&& other) noexcept;
-  StepLog(const StepLog&) = delete;
-  StepLog& operator=(const StepLog&) = delete;
-  ~StepLog();
   /// Append a row in one write (a stopped run keeps every step it finished). Throws OutputError
   /// when the write fails; the file then keeps exactly the whole rows before it (what a failed
   /// write left of the row is cut off) and takes no more.
   void row(const std::vector<double>& values);
-  bool isOpen() const { return fd_ >= 0; }
+  bool isOpen() const { return file_.isOpen(); }
 
  private:
-  void openForAppend();
-  void close() noexcept;
-
-  std::string path_;
-  int fd_ = -1;            ///< the file, opened to append
-  long long written_ = 0;  ///< its size: the header and the whole rows
+  AppendFile file_;
   std::size_t nColumns_ = 0;
 };
 

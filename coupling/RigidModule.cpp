@@ -21,13 +21,13 @@ void RigidModule::recordStep() {
   const double e = system_.kineticEnergy() + system_.potentialEnergy();
   if (!std::isfinite(e)) throw DivergenceError("rigid bodies: non-finite energy at t = " + std::to_string(system_.time()));
   maxEnergyDrift_ = std::max(maxEnergyDrift_, std::abs(e - energy0_));
-  if (csv_.is_open()) writeRows();
+  if (csv_.isOpen()) writeRows();
 }
 
 void RigidModule::writeRows() {
-  system_.writeCsvRows(csv_);
-  csv_.flush();
-  if (!csv_) throw OutputError("cannot write '" + csvPath_ + "' (is the disk full?)");
+  std::ostringstream rows;
+  system_.writeCsvRows(rows);
+  csv_.append(rows.str());  // one write: a step's rows whole or not at all
 }
 
 void RigidModule::addOutputFields(io::FieldFrame& frame) {
@@ -59,24 +59,20 @@ void RigidModule::addMetrics(std::map<std::string, double>& metrics) const {
 }
 
 void RigidModule::openOutput(const std::string& dir, const OutputStart& start) {
-  csvPath_ = dir + "/bodies.csv";
-  if (csv_.is_open()) csv_.close();
-  csv_.clear();
+  const std::string path = dir + "/bodies.csv";
+  csv_ = AppendFile();
+  std::ostringstream header;
+  RigidBodySystem::writeCsvHeader(header);
   if (start.continueFiles) {
     // nBodies rows at set-up (the state at firstStep) and after every committed step since.
-    std::ostringstream header;
-    RigidBodySystem::writeCsvHeader(header);
     std::string h = header.str();
     if (!h.empty() && h.back() == '\n') h.pop_back();
-    keepCsvRows(csvPath_, h, static_cast<long long>(system_.nBodies()) * (start.step - start.firstStep + 1));
-    csv_.open(csvPath_, std::ios::app);
-    if (!csv_) throw OutputError("cannot write '" + csvPath_ + "'");
+    keepCsvRows(path, h, static_cast<long long>(system_.nBodies()) * (start.step - start.firstStep + 1));
+    csv_ = AppendFile::open(path);
     return;
   }
   // A new file; a run restarted into a new folder starts it from the checkpoint's state.
-  csv_.open(csvPath_, std::ios::trunc);
-  if (!csv_) throw OutputError("cannot write '" + csvPath_ + "'");
-  RigidBodySystem::writeCsvHeader(csv_);
+  csv_ = AppendFile::create(path, header.str());
   writeRows();
 }
 

@@ -1,10 +1,10 @@
 #pragma once
 /// \file
 /// \brief The `bodies` section as a module of a run: rigid frames on joints and restraints.
+#include "core/RunLog.hpp"
 #include "coupling/Module.hpp"
 #include "structure/rigid/RigidBodySystem.hpp"
 
-#include <fstream>
 #include <string>
 
 namespace mfsi {
@@ -35,12 +35,12 @@ class RigidModule final : public Module {
   void recordStep();
 
  private:
-  /// Append the rows of the latest state to bodies.csv and flush; OutputError when it fails.
+  /// Append the rows of the latest state to bodies.csv in one write; OutputError when it fails
+  /// (the file then keeps the whole rows before them).
   void writeRows();
 
   RigidBodySystem system_;
-  std::string csvPath_;
-  std::ofstream csv_;
+  AppendFile csv_;  ///< bodies.csv
   double energy0_ = 0.0;
   double maxEnergyDrift_ = 0.0;
 };

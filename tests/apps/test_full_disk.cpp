@@ -108,22 +108,29 @@ std::vector<std::pair<std::string, std::string>> indexedDatasets(const std::stri
   return items;
 }
 
+/// A CSV file's data rows, each checked whole: the file ends a row, and every row has the header's
+/// number of values.
+int wholeRows(const std::string& path) {
+  const std::string csv = mfsi::test::readFile(path);
+  EXPECT_FALSE(csv.empty()) << path;
+  if (csv.empty()) return 0;
+  EXPECT_EQ(csv.back(), '\n') << path << " ends in a cut-off row";
+  std::istringstream in(csv);
+  std::string line;
+  std::getline(in, line);
+  const auto commas = std::count(line.begin(), line.end(), ',');
+  int rows = 0;
+  for (; std::getline(in, line); ++rows)
+    EXPECT_EQ(std::count(line.begin(), line.end(), ','), commas) << path << " row " << rows + 1 << ": " << line;
+  return rows;
+}
+
 /// Nothing in the run folder looks complete without being so.
 void expectNothingCutShort(const Outcome& r) {
   for (const auto& e : fs::recursive_directory_iterator(r.dir))
     EXPECT_NE(e.path().extension(), ".part") << "a temporary file was left behind: " << e.path();
   // steps.csv: the header, then whole rows of as many values.
-  if (fs::exists(r.dir + "/steps.csv")) {
-    const std::string csv = mfsi::test::readFile(r.dir + "/steps.csv");
-    ASSERT_FALSE(csv.empty());
-    EXPECT_EQ(csv.back(), '\n') << "steps.csv ends in a cut-off row";
-    std::istringstream in(csv);
-    std::string line;
-    std::getline(in, line);
-    const auto commas = std::count(line.begin(), line.end(), ',');
-    for (int row = 1; std::getline(in, line); ++row)
-      EXPECT_EQ(std::count(line.begin(), line.end(), ','), commas) << "steps.csv row " << row << ": " << line;
-  }
+  if (fs::exists(r.dir + "/steps.csv")) wholeRows(r.dir + "/steps.csv");
   // Every dataset the index refers to reads back.
   if (fs::exists(r.dir + "/fields.xdmf")) {
     const auto items = indexedDatasets(mfsi::test::readFile(r.dir + "/fields.xdmf"));
@@ -237,4 +244,35 @@ TEST(FullDisk, ASummaryThatCannotBeWrittenIsNoneAndTheRunStillFails) {
   EXPECT_NE(r.output.find("summary.json"), std::string::npos) << r.output;
   EXPECT_NE(r.output.find("is the disk full?"), std::string::npos) << r.output;
   expectNothingCutShort(r);
+}
+
+TEST(FullDisk, ABodiesCsvThatCannotBeWrittenKeepsWholeRows) {
+  // The double pendulum writes two rows of bodies.csv per step (1.26 MB over its 2,500 steps,
+  // steps.csv 142 kB): a limit of three times steps.csv stops bodies.csv in mid-run.
+  const std::string scene = std::string(MFSI_CASES_DIR) + "/double-pendulum.yaml";
+  const std::string dir0 = base("bodies") + "_reference", dir = base("bodies") + "/run";
+  mfsi::test::freshDir("full_disk_bodies");
+  fs::remove_all(dir0);
+  ASSERT_EQ(mfsi::test::run({MFSI_EXE, "run", scene, "--out", dir0}, {}).code, 0);
+  long long other = 0;
+  for (const auto& e : fs::recursive_directory_iterator(dir0))
+    if (e.is_regular_file() && e.path().filename() != "bodies.csv")
+      other = std::max(other, static_cast<long long>(e.file_size()));
+  const long long limit = 3 * other;
+  ASSERT_LT(limit, sizeOf(dir0 + "/bodies.csv") / 2) << "bodies.csv would not outgrow the limit in mid-run";
+  mfsi::test::SpawnOptions options;
+  options.fileSizeLimit = limit;
+  const auto done = mfsi::test::run({MFSI_EXE, "run", scene, "--out", dir}, options);
+  Outcome r;
+  r.dir = dir;
+  r.code = done.code;
+  r.output = done.output;
+  if (fs::exists(dir + "/summary.json")) r.summary = mfsi::test::readFile(dir + "/summary.json");
+  expectSavedError(r, "bodies.csv");
+  expectNothingCutShort(r);
+  // bodies.csv: the header, then whole rows (as many values each), nothing cut short.
+  const int rows = wholeRows(dir + "/bodies.csv");
+  EXPECT_GT(rows, 100);
+  EXPECT_EQ(rows % 2, 0) << "a step's two rows are written together";
+  EXPECT_LE(sizeOf(dir + "/bodies.csv"), limit);
 }
