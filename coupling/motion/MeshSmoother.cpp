@@ -415,11 +415,16 @@ MotionReport MeshSmoother::move(const ExecSpace& exec) {
 void MeshSmoother::saveState(io::StateWriter& w) const {
   w.putView("displacement", d_);
   w.putView("accepted", good_);
+  if (lastBase_.extent(0) > 0) w.putView("lastBase", lastBase_);  // the next motion's warm start
 }
 
 void MeshSmoother::loadState(const io::StateReader& r) {
   r.getView("displacement", d_);
   r.getView("accepted", good_);
+  if (r.has("lastBase")) {
+    lastBase_ = Real3View("mfsi::coupling::motion::lastBase", d_.extent(0));
+    r.getView("lastBase", lastBase_);
+  }
 }
 
 }  // namespace mfsi::coupling

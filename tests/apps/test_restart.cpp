@@ -190,3 +190,20 @@ TEST(Restart, TheExtrapolatedPredictorContinuesBitwise) {
 TEST(Restart, TheMembraneChannelContinuesBitwise) {
   expectRestartIsBitwise("membrane_channel", "membrane-channel", {"mesh.blocks.0.cells=[24,8,16]"}, 2);
 }
+
+// IQN-IMVJ carries its inverse Jacobian from step to step: it must be in the checkpoint.
+TEST(Restart, IqnImvjContinuesBitwise) {
+  expectRestartIsBitwise("flexible_cavity_imvj", "flexible-cavity",
+                         {"mesh.blocks.0.cells=[12,10,1]", "mesh.blocks.1.cells=[12,2,1]",
+                          "coupling.iqnJacobian=multiVector"},
+                         4);
+}
+
+// The mesh carried rigidly near the frame (meshMotion.bodies): the motion's warm start, the last
+// rigid part, must be in the checkpoint.
+TEST(Restart, TheRigidBlendContinuesBitwise) {
+  expectRestartIsBitwise("membrane_channel_blend", "membrane-channel",
+                         {"mesh.blocks.0.cells=[24,8,16]", "coupling.meshMotion.bodies={frame: {innerDistance: 0.2, "
+                                                           "outerDistance: 1.0}}"},
+                         2);
+}
