@@ -1,6 +1,7 @@
 #include "coupling/motion/RigidBlend.hpp"
 
 #include "core/Error.hpp"
+#include "core/HexGeometry.hpp"
 
 #include <Eigen/Geometry>
 
@@ -120,7 +121,8 @@ void RigidBlend::displacement(const ExecSpace& exec, const std::vector<RigidPlac
           const real a[3] = {screw(b, 6), screw(b, 7), screw(b, 8)};
           const real phi = wb * screw(b, 9), c = kmath::cos(phi), s = kmath::sin(phi);
           const real ar = a[0] * r[0] + a[1] * r[1] + a[2] * r[2];
-          const real axr[3] = {a[1] * r[2] - a[2] * r[1], a[2] * r[0] - a[0] * r[2], a[0] * r[1] - a[1] * r[0]};
+          real axr[3];
+          geom::cross(a, r, axr);
           for (int k = 0; k < 3; ++k)
             d[k] += wb * screw(b, 3 + k) + (c - 1) * r[k] + s * axr[k] + (1 - c) * ar * a[k];
         }

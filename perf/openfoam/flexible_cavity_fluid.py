@@ -1,7 +1,8 @@
 #!/usr/bin/env python3
 """Write the pimpleFoam case of the flexible-bottom cavity's fluid (see flexible_cavity_fluid.sh).
 
-    flexible_cavity_fluid.py N END_TIME [--bottom rigid|transpiring|moving] [--case DIR]
+    flexible_cavity_fluid.py N END_TIME [--bottom rigid|transpiring|moving|membrane] [--case DIR]
+                             [--motion FILE] [--dt DT]
 
 The fluid of cases/flexible-cavity.yaml with the membrane replaced by a prescribed bottom: a unit
 square, DEPTH thick (one cell, z faces "empty"), N x N cells (N a multiple of 8: N * 7/8 rows below
@@ -12,7 +13,12 @@ with v = TRANSPIRATION_V (1 - cos(2 pi t / 5)) into the cavity (u = 0), or `movi
 lifted to y = LIFT (1 - cos(2 pi t / 5)), the mesh following it (dynamicMotionSolverFvMesh,
 displacementLaplacian with uniform diffusivity; point displacement prescribed on the bottom, slip
 on the side walls, zero on lid, inlets and outlet), U `movingWallVelocity` on the bottom, and
-pimpleFoam's correctPhi on (pcorr), the mesh moved once per step (moveMeshOuterCorrectors no).
+pimpleFoam's correctPhi on (pcorr), the mesh moved once per step (moveMeshOuterCorrectors no);
+or `membrane`: as `moving`, but the bottom's nodes follow a recorded membrane motion (--motion, a
+JSON file {"points": [[x, y, z], ...], "times": [...], "displacements": [[[dx, dy, dz], ...], ...]}
+written by flexible_cavity_membrane.sh from an mfsi FSI run), prescribed through
+`timeVaryingMappedFixedValue` (nearest point; the times are the steps', so OpenFOAM's linear
+interpolation in time is exact at every step).
 rho = 1, nu = 0.01, dt = 0.1, backward (BDF2), Gauss linear everywhere, PIMPLE with 10 outer
 correctors (residual control 1e-7), 2 pressure correctors, 1 non-orthogonal corrector. The
 `forces` function object writes the bottom patch force (rho 1) every step to
@@ -32,7 +38,8 @@ PERIOD = 5.0            # 1 - cos(2 pi t / PERIOD) ramp of lid, inlet and transp
 DT = 0.1
 TRANSPIRATION_V = 0.02  # bottom normal velocity amplitude of --bottom transpiring
 LIFT = 0.05             # bottom lift y = LIFT (1 - cos(2 pi t / PERIOD)) of --bottom moving
-BOTTOMS = ("rigid", "transpiring", "moving")
+BOTTOMS = ("rigid", "transpiring", "moving", "membrane")
+MOVING = ("moving", "membrane")
 
 
 def header(cls, obj):
@@ -94,7 +101,7 @@ def velocity_field(n, end_time, bottom):
                    % (i, ramp_table(((i + 0.5) / n_up, 0, 0), end_time)))
     if bottom == "rigid":
         out.append("bottom { type noSlip; }\n")
-    elif bottom == "moving":  # the wall's velocity from the mesh motion
+    elif bottom in MOVING:  # the wall's velocity from the mesh motion
         out.append("bottom { type movingWallVelocity; value uniform (0 0 0); }\n")
     else:
         out.append("bottom { type uniformFixedValue; uniformValue %s; }\n"
@@ -113,11 +120,16 @@ boundaryField
 }
 """
 
-def point_displacement(n, end_time):
-    """0/pointDisplacement of --bottom moving: the bottom lifted, side walls sliding, rest fixed."""
+def point_displacement(n, end_time, bottom):
+    """0/pointDisplacement of --bottom moving or membrane: the bottom lifted (moving) or following the
+    recorded motion in constant/boundaryData (membrane), side walls sliding, rest fixed."""
     out = [header("pointVectorField", "pointDisplacement"),
            "dimensions [0 1 0 0 0 0 0];\ninternalField uniform (0 0 0);\nboundaryField\n{\n"]
-    out.append("bottom { type uniformFixedValue; uniformValue %s; }\n" % ramp_table((0, LIFT, 0), end_time))
+    if bottom == "moving":
+        out.append("bottom { type uniformFixedValue; uniformValue %s; }\n" % ramp_table((0, LIFT, 0), end_time))
+    else:
+        out.append("bottom { type timeVaryingMappedFixedValue; mapMethod nearest; offset (0 0 0); "
+                   "setAverage false; value uniform (0 0 0); }\n")
     out.append("walls { type slip; }\n")
     for patch in ["lid"] + ["inlet%d" % i for i in range(n // 8)] + ["outlet"]:
         out.append("%s { type fixedValue; value uniform (0 0 0); }\n" % patch)
@@ -146,7 +158,7 @@ snGradSchemes { default corrected; }
 
 def solution(bottom):
     """fvSolution; --bottom moving adds the mesh motion's solvers and PIMPLE settings."""
-    moving = bottom == "moving"
+    moving = bottom in MOVING
     return header("dictionary", "fvSolution") + """solvers
 {
     p { solver PCG; preconditioner DIC; tolerance 1e-10; relTol 0.01; }
@@ -194,7 +206,27 @@ functions
 """ % (end_time, DT)
 
 
-def write_case(case, n, end_time, bottom):
+def vector_list(rows):
+    return "%d\n(\n%s\n)\n" % (len(rows), "\n".join("(%.12g %.12g %.12g)" % tuple(r) for r in rows))
+
+
+def boundary_data(motion_file, end_time):
+    """{relative path: text} of constant/boundaryData/bottom from a recorded membrane motion."""
+    import json
+    with open(motion_file) as f:
+        motion = json.load(f)
+    points, times, disps = motion["points"], motion["times"], motion["displacements"]
+    if len(times) != len(disps) or any(len(d) != len(points) for d in disps):
+        raise SystemExit("%s: %d times, %d displacement sets, %d points" % (motion_file, len(times), len(disps), len(points)))
+    if times[0] > 1e-12 or times[-1] < end_time - 1e-9:
+        raise SystemExit("%s: times %g..%g do not cover 0..%g" % (motion_file, times[0], times[-1], end_time))
+    files = {"constant/boundaryData/bottom/points": vector_list(points)}
+    for t, d in zip(times, disps):
+        files["constant/boundaryData/bottom/%.8g/pointDisplacement" % t] = vector_list(d)
+    return files
+
+
+def write_case(case, n, end_time, bottom, motion=None):
     files = {
         "system/blockMeshDict": block_mesh_dict(n),
         "system/controlDict": control_dict(end_time),
@@ -205,9 +237,11 @@ def write_case(case, n, end_time, bottom):
         "0/U": velocity_field(n, end_time, bottom),
         "0/p": PRESSURE,
     }
-    if bottom == "moving":
+    if bottom in MOVING:
         files["constant/dynamicMeshDict"] = DYNAMIC_MESH
-        files["0/pointDisplacement"] = point_displacement(n, end_time)
+        files["0/pointDisplacement"] = point_displacement(n, end_time, bottom)
+    if bottom == "membrane":
+        files.update(boundary_data(motion, end_time))
     for rel, text in files.items():
         path = os.path.join(case, rel)
         os.makedirs(os.path.dirname(path), exist_ok=True)
@@ -216,17 +250,23 @@ def write_case(case, n, end_time, bottom):
 
 
 def main():
+    global DT
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     ap.add_argument("n", type=int, metavar="N", help="cells per side (a multiple of 8)")
     ap.add_argument("end_time", type=float, metavar="END_TIME", help="simulated time [s]")
     ap.add_argument("--bottom", choices=BOTTOMS, default="rigid")
     ap.add_argument("--case", default=".", help="case directory (default: the current one)")
+    ap.add_argument("--motion", help="recorded bottom motion (JSON) for --bottom membrane")
+    ap.add_argument("--dt", type=float, default=DT, help="time step (default %g)" % DT)
     args = ap.parse_args()
+    DT = args.dt
+    if (args.bottom == "membrane") != (args.motion is not None):
+        ap.error("--motion goes with --bottom membrane, and only with it")
     if args.n < 8 or args.n % 8:
         ap.error("N must be a positive multiple of 8 (got %d)" % args.n)
     if args.end_time <= 0:
         ap.error("END_TIME must be positive")
-    write_case(args.case, args.n, args.end_time, args.bottom)
+    write_case(args.case, args.n, args.end_time, args.bottom, args.motion)
 
 
 if __name__ == "__main__":
