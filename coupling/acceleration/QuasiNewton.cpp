@@ -130,7 +130,7 @@ InterfaceVector QuasiNewton::scaled(const InterfaceVector& a) const {
 void QuasiNewton::record(const InterfaceVector& xt, const InterfaceVector& r) {
   if (!havePrevious_) setScaling(r);
   if (havePrevious_) {
-    columns_.push_front(Column{r - rPrevious_, xt - xtPrevious_, stepIndex_});
+    columns_.push_front(Column{r - rPrevious_, xt - xtPrevious_, stepIndex_, InterfaceVector()});
     if (qrValid_) insertFront(scaled(columns_.front().v));
     while (static_cast<int>(columns_.size()) > options_.iqnMaxCols) {
       columns_.pop_back();
@@ -353,22 +353,33 @@ IqnImvj::IqnImvj(const AccelerationOptions& options, std::vector<InterfaceBlock>
   jPrev_ = static_cast<float>(1 - options_.omegaInit) * Eigen::MatrixXf::Identity(size_, size_);
 }
 
+void IqnImvj::beginStep() {
+  QuasiNewton::beginStep();
+  haveJr_ = false;
+}
+
 void IqnImvj::step(const InterfaceVector& xt, const InterfaceVector& r, InterfaceVector& x,
                    AccelerationReport& report) {
   record(xt, r);
+  const InterfaceVector jr = (jPrev_ * r.cast<float>()).cast<double>();
+  if (!columns_.empty() && columns_.front().jv.size() == 0) {  // the column record() just made
+    Column& c = columns_.front();
+    c.jv = haveJr_ ? InterfaceVector(jr - jrPrevious_) : InterfaceVector((jPrev_ * c.v.cast<float>()).cast<double>());
+  }
+  jrPrevious_ = jr;
+  haveJr_ = true;
   aitken_.next(*this, r);
   report.dropped = columns_.empty() ? 0 : factorise();
   const auto k = columns_.empty() ? Eigen::Index(0) : static_cast<Eigen::Index>(factorisation().q.size());
   // next = xt + W alpha - J_prev (r + V alpha), alpha IQN-ILS's coefficients.
-  InterfaceVector next = xt, rv = r;
+  InterfaceVector next = xt - jr;
   if (k > 0) {
     const Eigen::VectorXd alpha = coefficients(r);
     for (Eigen::Index j = 0; j < k; ++j) {
-      next += alpha[j] * columns_[static_cast<std::size_t>(j)].w;
-      rv += alpha[j] * columns_[static_cast<std::size_t>(j)].v;
+      const Column& c = columns_[static_cast<std::size_t>(j)];
+      next += alpha[j] * (c.w - c.jv);
     }
   }
-  next -= (jPrev_ * rv.cast<float>()).cast<double>();
   accept(next, r, static_cast<int>(k), x, report);
 }
 
@@ -378,16 +389,27 @@ void IqnImvj::endStep() {
   const Factorisation& f = factorisation();
   const auto k = static_cast<Eigen::Index>(f.q.size());
   if (k == 0) return;
-  // J += Z V^+ with Z = W - J V (n x k) and V^+ = R^-1 Q^T S (k x n).
-  Eigen::MatrixXd V(size_, k), W(size_, k), QtS(k, size_);
-  for (Eigen::Index j = 0; j < k; ++j) {
-    V.col(j) = columns_[static_cast<std::size_t>(j)].v;
-    W.col(j) = columns_[static_cast<std::size_t>(j)].w;
+  // J += Z V^+ with Z = W - J V (n x k) and V^+ = R^-1 Q^T S (k x n). The columns of earlier steps
+  // have J v = w from the last update, so only this step's columns (a zero column of Z elsewhere)
+  // enter the product.
+  Eigen::MatrixXd QtS(k, size_);
+  for (Eigen::Index j = 0; j < k; ++j)
     QtS.row(j) = scaled(f.q[static_cast<std::size_t>(j)]).transpose();  // (S q)^T = q^T S, S diagonal
+  const Eigen::MatrixXd pinv = f.r.triangularView<Eigen::Upper>().solve(QtS);
+  std::vector<Eigen::Index> fresh;
+  for (Eigen::Index j = 0; j < k; ++j) {
+    const Column& c = columns_[static_cast<std::size_t>(j)];
+    if (c.jv != c.w) fresh.push_back(j);
   }
-  const Eigen::MatrixXf Z = (W - (jPrev_ * V.cast<float>()).cast<double>()).cast<float>();
-  const Eigen::MatrixXf pinv = f.r.triangularView<Eigen::Upper>().solve(QtS).cast<float>();
-  jPrev_.noalias() += Z * pinv;
+  const auto m = static_cast<Eigen::Index>(fresh.size());
+  Eigen::MatrixXf Z(size_, m), P(m, size_);
+  for (Eigen::Index i = 0; i < m; ++i) {
+    const Column& c = columns_[static_cast<std::size_t>(fresh[static_cast<std::size_t>(i)])];
+    Z.col(i) = (c.w - c.jv).cast<float>();
+    P.row(i) = pinv.row(fresh[static_cast<std::size_t>(i)]).cast<float>();
+  }
+  if (m > 0) jPrev_.noalias() += Z * P;
+  for (Column& c : columns_) c.jv = c.w;
 }
 
 void IqnImvj::saveState(io::StateWriter& w) const {
@@ -399,6 +421,8 @@ void IqnImvj::loadState(const io::StateReader& r) {
   QuasiNewton::loadState(r);
   const auto j = r.doubles("inverseJacobian", static_cast<long long>(size_) * size_);
   jPrev_ = Eigen::Map<const Eigen::MatrixXd>(j.data(), size_, size_).cast<float>();
+  for (Column& c : columns_) c.jv = c.w;  // as endStep left them
+  haveJr_ = false;
 }
 
 }  // namespace mfsi::coupling

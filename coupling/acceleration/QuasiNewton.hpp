@@ -41,6 +41,7 @@ class QuasiNewton : public Acceleration {
   struct Column {
     InterfaceVector v, w;
     long step = 0;  ///< the time step it was made in
+    InterfaceVector jv;  ///< IQN-IMVJ only: J_prev v with the J_prev of this step (empty elsewhere)
   };
   /// The thin QR factorisation S V = Q R of the filtered history.
   struct Factorisation {
@@ -108,6 +109,7 @@ class IqnImvj final : public QuasiNewton {
   static constexpr Eigen::Index kMaxUnknowns = 20000;
   /// Throws InputError past kMaxUnknowns or on more than one rank.
   IqnImvj(const AccelerationOptions& options, std::vector<InterfaceBlock> layout, const SolverComm& comm);
+  void beginStep() override;
   void endStep() override;
   void saveState(io::StateWriter& w) const override;
   void loadState(const io::StateReader& r) override;
@@ -122,6 +124,11 @@ class IqnImvj final : public QuasiNewton {
   /// Single precision: the matrix-vector product of every pass reads n^2 values (memory-bound), and
   /// the Jacobian is a model; the fixed point is judged on the residual, in double.
   Eigen::MatrixXf jPrev_;
+  /// J_prev r of the step's previous pass: a new column's J_prev v is the difference of two of
+  /// them, so no pass multiplies J_prev by the history. After each step's update J_prev v = w holds
+  /// on every kept column, which is what carries them to the next step without a product either.
+  InterfaceVector jrPrevious_;
+  bool haveJr_ = false;
 };
 
 }  // namespace mfsi::coupling
