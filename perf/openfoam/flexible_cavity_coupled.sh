@@ -10,6 +10,8 @@
 #
 #   perf/openfoam/flexible_cavity_coupled.sh        # ~40 min on one core
 #   MFSI=path/to/mfsi END=2 perf/openfoam/flexible_cavity_coupled.sh   # to t = 2 s (a quick check)
+#   COUPLED_DIR=dir perf/openfoam/flexible_cavity_coupled.sh   # check 2 from an earlier run's
+#                                        # coupled.csv and coupled.log (flexible_cavity_coupled.py WORK)
 #
 # Output: results/flexible_cavity_coupled.txt (and stdout). Work files in $OF_WORK.
 set -euo pipefail
@@ -30,7 +32,14 @@ OMP_PROC_BIND=false "$mfsi" run "$REPO/cases/flexible-cavity.yaml" --out "$work/
 out=$RESULTS/flexible_cavity_coupled.txt
 [ "$end" = 12 ] || out=$work/flexible_cavity_coupled.txt   # a shorter run does not replace the results
 status=0
-"$py" "$OF_DIR/flexible_cavity_coupled.py" "$work/coupled" --end "$end" | tee "$work/coupled.log" || status=$?
+if [ -n "${COUPLED_DIR:-}" ]; then  # an earlier run of check 2 (its coupled.csv and coupled.log)
+  mkdir -p "$work/coupled"
+  cp "$COUPLED_DIR/coupled.csv" "$work/coupled/" && cp "$COUPLED_DIR/coupled.log" "$work/coupled.log"
+  grep -q "^total .* fluid runs" "$work/coupled.log" || { echo "$COUPLED_DIR/coupled.log: not a finished run" >&2; exit 1; }
+  ! grep -q "NOT" "$work/coupled.log" || status=1
+else
+  "$py" "$OF_DIR/flexible_cavity_coupled.py" "$work/coupled" --end "$end" | tee "$work/coupled.log" || status=$?
+fi
 
 # check 1: OpenFOAM on mfsi's recorded motion
 "$py" -c "import sys; sys.path.insert(0, sys.argv[1]); import flexible_cavity_coupled as c; \
