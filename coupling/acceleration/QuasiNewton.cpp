@@ -363,8 +363,9 @@ void IqnImvj::step(const InterfaceVector& xt, const InterfaceVector& r, Interfac
   record(xt, r);
   const InterfaceVector jr = (jPrev_ * r.cast<float>()).cast<double>();
   if (!columns_.empty() && columns_.front().jv.size() == 0) {  // the column record() just made
-    Column& c = columns_.front();
-    c.jv = haveJr_ ? InterfaceVector(jr - jrPrevious_) : InterfaceVector((jPrev_ * c.v.cast<float>()).cast<double>());
+    // record() pairs a pass only with an earlier pass of the same step, whose J r is kept.
+    MFSI_ASSERT(haveJr_, "IQN-IMVJ: a new column without the previous pass's J r");
+    columns_.front().jv = jr - jrPrevious_;
   }
   jrPrevious_ = jr;
   haveJr_ = true;

@@ -29,12 +29,13 @@ About 35 minutes on one core for 12 s.
 import argparse
 import json
 import os
-import re
 import shutil
 import subprocess
 import sys
 
 import numpy as np
+
+import foamtools
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 GEN = os.path.join(HERE, "flexible_cavity_fluid.py")
@@ -58,12 +59,12 @@ def run_fluid(work, disp, dt, n_steps, outer):
         json.dump(motion, f)
     subprocess.run([sys.executable, GEN, str(N), repr(t_end), "--bottom", "membrane", "--dt", repr(dt),
                     "--motion", os.path.join(work, "motion.json"), "--case", case], check=True)
-    edits = {"system/controlDict": ("writeInterval 100000;", "writeInterval 1;"),
-             "system/fvSolution": ("nOuterCorrectors 10;", "nOuterCorrectors %d;" % outer)}
-    # the momentum solver: symmetric Gauss-Seidel diverges on some far iterates; BiCGStab does not
-    edits2 = {"system/fvSolution": ("solver smoothSolver; smoother symGaussSeidel;",
-                                    "solver PBiCGStab; preconditioner DILU;")}
-    for rel, (old, new) in list(edits.items()) + list(edits2.items()):
+    edits = [("system/controlDict", "writeInterval 100000;", "writeInterval 1;"),
+             ("system/fvSolution", "nOuterCorrectors 10;", "nOuterCorrectors %d;" % outer),
+             # the momentum solver: symmetric Gauss-Seidel diverges on some far iterates; BiCGStab does not
+             ("system/fvSolution", "solver smoothSolver; smoother symGaussSeidel;",
+              "solver PBiCGStab; preconditioner DILU;")]
+    for rel, old, new in edits:
         path = os.path.join(case, rel)
         text = open(path).read()
         if old not in text:
@@ -76,10 +77,8 @@ def run_fluid(work, disp, dt, n_steps, outer):
         if done.returncode != 0:
             return None
     p = np.zeros((n_steps + 1, N))
-    for k in range(1, n_steps + 1):
-        text = open(os.path.join(case, "%.8g" % (k * dt), "p")).read()
-        m = re.search(r"internalField\s+nonuniform\s+List<scalar>\s*(\d+)\s*\(", text)
-        p[k] = np.array(text[m.end():].split(")", 1)[0].split()[:N], float)  # bottom row: cells 0..N-1
+    for k in range(1, n_steps + 1):  # the bottom row: cells 0..N-1
+        p[k] = foamtools.read_internal_field(os.path.join(case, "%.8g" % (k * dt), "p"))[:N]
     return p
 
 

@@ -8,7 +8,7 @@
 #      coupled implicitly step by step with IQN-ILS (flexible_cavity_coupled.py, its defaults), its
 #      first peak against mfsi's and Mok's.
 #
-#   perf/openfoam/flexible_cavity_coupled.sh        # ~40 min on one core
+#   perf/openfoam/flexible_cavity_coupled.sh        # ~45 min on one core
 #   MFSI=path/to/mfsi END=2 perf/openfoam/flexible_cavity_coupled.sh   # to t = 2 s (a quick check)
 #   COUPLED_DIR=dir perf/openfoam/flexible_cavity_coupled.sh   # check 2 from an earlier run's
 #                                        # coupled.csv and coupled.log (flexible_cavity_coupled.py WORK)
@@ -51,19 +51,14 @@ run_foam "$case" log.pimpleFoam pimpleFoam
 
 "$py" - "$case/postProcessing/forcesBottom/0/force.dat" "$work/mfsi/steps.csv" "$work/coupled/coupled.csv" \
     "$REPO/tests/data/flexible_cavity_mok2001.csv" "$status" "$end" \
-    "$(git -C "$REPO" describe --always --dirty 2>/dev/null || echo unknown)" \
+    "$(git -C "$REPO" describe --always --dirty 2>/dev/null || echo unknown)" "$OF_DIR" \
     <<'PY' | tee "$out"
-import csv, re, sys
-force_dat, steps, coupled, mok, status, end, commit = sys.argv[1:]
+import csv, sys
+force_dat, steps, coupled, mok, status, end, commit, of_dir = sys.argv[1:]
+sys.path.insert(0, of_dir)
+import foamtools
 n = int(round(float(end) / 0.1))
-NUM = r"[-+]?(?:\d+\.?\d*|\.\d+)(?:[eE][-+]?\d+)?"
-foam = {}
-for line in open(force_dat):
-    if line.startswith("#") or not line.strip():
-        continue
-    t, rest = line.split(None, 1)
-    total = re.findall(r"\(([^()]*)\)", rest)[0]
-    foam[int(round(float(t) / 0.1))] = float(re.findall(NUM, total)[1])
+foam = {k: f[0] for k, f in foamtools.read_force_y(force_dat, 0.1).items()}  # total force
 ours = {int(round(float(r["time"]) / 0.1)): (float(r["fluid.bottom.force_y"]), float(r["membrane.bottom.centreUy"]))
         for r in csv.DictReader(open(steps))}
 ind = {int(round(float(r["t_s"]) / 0.1)): float(r["midpoint_dy"]) for r in csv.DictReader(open(coupled))}

@@ -16,7 +16,7 @@ on the side walls, zero on lid, inlets and outlet), U `movingWallVelocity` on th
 pimpleFoam's correctPhi on (pcorr), the mesh moved once per step (moveMeshOuterCorrectors no);
 or `membrane`: as `moving`, but the bottom's nodes follow a recorded membrane motion (--motion, a
 JSON file {"points": [[x, y, z], ...], "times": [...], "displacements": [[[dx, dy, dz], ...], ...]}
-written by flexible_cavity_membrane.sh from an mfsi FSI run), prescribed through
+written from an mfsi FSI run by flexible_cavity_coupled.py), prescribed through
 `timeVaryingMappedFixedValue` (nearest point; the times are the steps', so OpenFOAM's linear
 interpolation in time is exact at every step).
 rho = 1, nu = 0.01, dt = 0.1, backward (BDF2), Gauss linear everywhere, PIMPLE with 10 outer

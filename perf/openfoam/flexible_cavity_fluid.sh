@@ -109,24 +109,16 @@ done
 echo "load after: $(load_note)"
 
 python3 -B - "$RESULTS/flexible_cavity_fluid.txt" "$WORK" "$end" "$n" \
-    "$(git -C "$REPO" describe --always --dirty 2>/dev/null || echo unknown)" <<'EOF'
-import json, os, re, sys
-result, work, end, n, commit = sys.argv[1:]
-NUM = r"[-+]?(?:\d+\.?\d*|\.\d+)(?:[eE][-+]?\d+)?"
+    "$(git -C "$REPO" describe --always --dirty 2>/dev/null || echo unknown)" "$OF_DIR" <<'EOF'
+import json, os, sys
+result, work, end, n, commit, of_dir = sys.argv[1:]
+sys.path.insert(0, of_dir)
+import foamtools
 
 def foam_pressure_fy(case):
     """{step index: pressure force y} from the forces function object's force.dat."""
     path = os.path.join(case, "postProcessing/forcesBottom/0/force.dat")
-    out = {}
-    for line in open(path):
-        if line.startswith("#") or not line.strip():
-            continue
-        t, rest = line.split(None, 1)
-        groups = re.findall(r"\(([^()]*)\)", rest)  # (total) (pressure) (viscous)
-        if len(groups) != 3:
-            sys.exit("%s: cannot read line %r" % (path, line))
-        out[int(round(float(t) / 0.1))] = float(re.findall(NUM, groups[1])[1])
-    return out
+    return {k: f[1] for k, f in foamtools.read_force_y(path, 0.1).items()}
 
 def ours_pressure_fy(bottom, t):
     path = os.path.join(work, "mfsi_flexible_cavity_%s_t%d" % (bottom, t), "summary.json")

@@ -131,6 +131,22 @@ def face_centre(points, face):
     return tuple(x / atot for x in acc)
 
 
+def read_force_y(path, dt):
+    """{step index: (total, pressure, viscous) y components} of a `forces` function object's
+    force.dat written every step of dt."""
+    out = {}
+    with open(path) as f:
+        for line in f:
+            if line.startswith("#") or not line.strip():
+                continue
+            t, rest = line.split(None, 1)
+            groups = re.findall(r"\(([^()]*)\)", rest)  # (total) (pressure) (viscous)
+            if len(groups) != 3:
+                raise ValueError("%s: cannot read line %r" % (path, line))
+            out[int(round(float(t) / dt))] = tuple(float(re.findall(NUMBER, g)[1]) for g in groups)
+    return out
+
+
 def parse_log(path):
     """Per time step of a solver log: [(time, executionTime, clockTime)] and the last residual lines."""
     steps, t = [], None
