@@ -253,6 +253,9 @@ int commandRun(std::string sceneArg, const std::vector<std::string>& sets, std::
         std::cout << "continuing from " << checkpoint << " (step " << sim->completedSteps() << ", t = "
                   << sim->completedTime() << ")\n";
         for (const std::string& c : changes) std::cout << "  changed on restart: " << c << "\n";
+        if (sim->carriedFromRanks() > 0)
+          std::cout << "  written on " << sim->carriedFromRanks() << " rank(s), continued on " << sim->ranks()
+                    << ": the state is carried by global ids (to the solvers' tolerances, not bitwise)\n";
       }
     }
     started = true;

@@ -438,6 +438,11 @@ std::string Simulation::writeCheckpoint(const std::string& outDir, const TimeSta
         mesh.putView("points", mesh_.points());
       }
     }
+    if (ranks_ > 1 && hasMesh_) {  // what carries the state to another decomposition (restore)
+      if (!partIds_) partIds_ = io::partIds(localMesh_, mesh_);
+      io::StateWriter part(*file, "/run/part");
+      io::writePartIds(part, *partIds_);
+    }
     for (const Module* m : reporting_) {
       io::StateWriter w(*file, "/modules/" + m->name());
       m->saveState(w);
@@ -505,6 +510,39 @@ std::string Simulation::runFolderOf(const std::string& checkpointFile) {
   return (dir.filename() == "checkpoints" ? dir.parent_path() : dir).string();
 }
 
+io::Hdf5File Simulation::carryCheckpoint(const io::Hdf5File& first, const std::string& checkpointFile,
+                                         int writtenOn) {
+  if (!hasMesh_ && writtenOn != ranks_)
+    throw InputError("--restart: '" + checkpointFile + "' was written by a run on " + std::to_string(writtenOn) +
+                     " rank(s); a scene without a mesh continues on as many (mpirun -np " +
+                     std::to_string(writtenOn) + "), not " + std::to_string(ranks_));
+  std::vector<io::Hdf5File> others;
+  for (int r = 1; r < writtenOn; ++r) {
+    const std::string part = rankFile(checkpointFile, r);
+    try {
+      others.push_back(io::Hdf5File::openRead(part));
+    } catch (const OutputError& e) {
+      throw InputError("--restart: '" + checkpointFile + "' was written by " + std::to_string(writtenOn) +
+                       " ranks, and rank " + std::to_string(r) + "'s part cannot be read: " + e.what());
+    }
+  }
+  std::vector<const io::Hdf5File*> parts{&first};
+  for (const io::Hdf5File& f : others) parts.push_back(&f);
+  std::vector<io::PartIds> old;
+  for (const io::Hdf5File* f : parts) {
+    if (writtenOn > 1 && !f->has("/run/part/cells"))
+      throw InputError("--restart: '" + f->path() + "' has no global ids (/run/part): it was written before "
+                       "checkpoints could move to another decomposition; continue it on " +
+                       std::to_string(writtenOn) + " ranks with the same partition");
+    old.push_back(writtenOn > 1 ? io::readPartIds(io::StateReader(*f, "/run/part"), mesh_) : io::wholeMeshIds(mesh_));
+  }
+  const io::PartIds mine = ranks_ > 1 ? io::partIds(localMesh_, mesh_) : io::wholeMeshIds(mesh_);
+  io::Hdf5File carried = io::Hdf5File::scratch(checkpointFile + " (carried to rank " + std::to_string(rank_) +
+                                               " of " + std::to_string(ranks_) + ")");
+  io::redistribute(parts, old, mine, carried);
+  return carried;
+}
+
 std::vector<std::string> Simulation::restore(const std::string& checkpointFile, bool allowChanges) {
   ScopedTimer timer(timers_, "restore");
   io::Hdf5File file = [&] {
@@ -516,13 +554,10 @@ std::vector<std::string> Simulation::restore(const std::string& checkpointFile, 
   }();
   const io::StateReader run(file, "/run");
   const long long writtenOn = run.has("ranks") ? run.integer("ranks") : 1;
-  if (writtenOn != ranks_)
-    throw InputError("--restart: '" + checkpointFile + "' was written by a run on " + std::to_string(writtenOn) +
-                     " rank(s); continue it on as many (mpirun -np " + std::to_string(writtenOn) + "), not " +
-                     std::to_string(ranks_));
-  if (ranks_ > 1 && run.integer("partition") != partitionHash_)
-    throw InputError("--restart: '" + checkpointFile + "' holds another decomposition of the mesh than this run's "
-                     "(a different METIS?)");
+  if (writtenOn < 1 || writtenOn > 1000000)
+    throw InputError("--restart: '" + checkpointFile + "': /run/ranks is " + std::to_string(writtenOn));
+  // Another rank count or partition: the state is carried across by global ids (below).
+  const bool carried = writtenOn != ranks_ || (ranks_ > 1 && run.integer("partition") != partitionHash_);
   const std::string before = run.text("scene");
   std::string refused;
   std::vector<std::string> accepted;
@@ -564,9 +599,13 @@ std::vector<std::string> Simulation::restore(const std::string& checkpointFile, 
       Kokkos::deep_copy(localMesh_.points(), x);
     }
   }
-  // Several ranks: each rank's modules from its own file.
+  // Several ranks: each rank's modules from its own file; another decomposition: from a file in
+  // memory that this rank's part of the state is carried into from every part of the old one.
   std::optional<io::Hdf5File> own;
-  if (rank_ > 0) {
+  if (carried) {
+    own.emplace(carryCheckpoint(file, checkpointFile, static_cast<int>(writtenOn)));
+    carriedFromRanks_ = static_cast<int>(writtenOn);
+  } else if (rank_ > 0) {
     const std::string part = rankFile(checkpointFile, rank_);
     try {
       own.emplace(io::Hdf5File::openRead(part));

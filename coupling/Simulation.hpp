@@ -3,8 +3,10 @@
 /// \brief The run driver: builds the mesh and exactly the modules a scene names, then steps them.
 #include "coupling/Module.hpp"
 #include "core/RunLog.hpp"
+#include "core/io/Redistribute.hpp"
 
 #include <cstdint>
+#include <optional>
 
 namespace mfsi {
 
@@ -97,6 +99,9 @@ class Simulation {
   /// diverged run reports how far it got).
   long long completedSteps() const { return completedSteps_; }
   double completedTime() const { return completedTime_; }
+  /// After restore(): the ranks of the run that wrote the checkpoint, when its decomposition was
+  /// not this run's (the state was carried across, core/io/Redistribute); 0 otherwise.
+  int carriedFromRanks() const { return carriedFromRanks_; }
   /// Path of the last checkpoint this run wrote ("" if none): where a diverged run can go back to.
   const std::string& lastCheckpoint() const { return lastCheckpoint_; }
 
@@ -108,6 +113,9 @@ class Simulation {
   /// last, once every rank has committed its own, so a checkpoint that a listing finds is whole.
   std::string writeCheckpoint(const std::string& outDir, const TimeState& ts, const io::FieldSeries& fields,
                               double nextFrameTime, long long lastFrameStep, double wallSeconds);
+  /// This rank's part of a checkpoint written on another decomposition (`writtenOn` ranks, its
+  /// rank 0's file already open as `first`), carried into a file in memory (core/io/Redistribute).
+  io::Hdf5File carryCheckpoint(const io::Hdf5File& first, const std::string& checkpointFile, int writtenOn);
   /// The state now, as one output frame: the scene mesh's grid "mesh" (positions, displacement
   /// from the reference mesh, each cell's scaled Jacobian) and every module's fields.
   io::FieldFrame fieldFrame(double time, long long step);
@@ -127,6 +135,9 @@ class Simulation {
   HexMesh localMesh_;
   MeshGeometry localGeometry_;
   RankDomain domain_;
+  int carriedFromRanks_ = 0;
+  /// Several ranks: this rank's global ids, as its checkpoints record them (made at the first one).
+  std::optional<io::PartIds> partIds_;
   std::int64_t partitionHash_ = 0;  ///< several ranks: a hash of the cell -> rank map (checkpoints hold it)
   TimeOptions time_;
   long long nSteps_ = 0;  ///< from time_ (checked at set-up)

@@ -322,9 +322,9 @@ void BoundaryConditions::setWallVelocity(const std::string& name, const ConstRea
 
 void BoundaryConditions::saveState(io::StateWriter& w) const {
   w.putReal("time", time_);
-  w.putView("velocity", velocity_);
-  w.putView("pressure", pressure_);
-  w.putView("external", external_);
+  w.putView("velocity", velocity_, io::Entity::BoundaryFaces);
+  w.putView("pressure", pressure_, io::Entity::BoundaryFaces);
+  w.putView("external", external_, io::Entity::BoundaryFaces);
   std::vector<double> patchValues;
   for (const ResolvedPatch& rp : patches_) patchValues.insert(patchValues.end(), {rp.currentPressure, rp.currentFlowRate});
   w.put("patchPressureAndFlowRate", patchValues);

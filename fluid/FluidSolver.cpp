@@ -559,32 +559,32 @@ void FluidSolver::saveState(io::StateWriter& w) const {
   exec_.fence();
   // Fields a step reads before it writes them; the scratch of an outer iteration (HbyA, the
   // right-hand sides, the face coefficients and fluxes of one corrector) is not kept.
-  w.putView("U", U_);
-  w.putView("U0", U0_);
-  w.putView("U00", U00_);
-  w.putView("p", p_);
-  w.putView("pPrevIter", pPrev_);
-  w.putView("p0", p0_);
-  w.putView("p00", p00_);
-  w.putView("V0", V0_);
-  w.putView("V00", V00_);
-  w.putView("gradP", gradP_);
-  w.putView("rAU", rAU_);
+  w.putView("U", U_, io::Entity::Cells);
+  w.putView("U0", U0_, io::Entity::Cells);
+  w.putView("U00", U00_, io::Entity::Cells);
+  w.putView("p", p_, io::Entity::Cells);
+  w.putView("pPrevIter", pPrev_, io::Entity::Cells);
+  w.putView("p0", p0_, io::Entity::Cells);
+  w.putView("p00", p00_, io::Entity::Cells);
+  w.putView("V0", V0_, io::Entity::Cells);
+  w.putView("V00", V00_, io::Entity::Cells);
+  w.putView("gradP", gradP_, io::Entity::Cells);
+  w.putView("rAU", rAU_, io::Entity::Cells);
   w.putBool("gradUCurrent", gradUCurrent_);
-  if (gradUCurrent_) w.putView("gradU", gradU_);
-  w.putView("phi", phi_);
-  w.putView("meshPhi", meshPhi_);
-  w.putView("dphi", dphi_);
-  w.putView("dphi0", dphi0_);
-  w.putView("dphi00", dphi00_);
-  w.putView("sweptNew", sweptNew_);
-  w.putView("sweptOld", sweptOld_);
-  w.putView("Ub", Ub_);
-  w.putView("faceMeshVelocity", faceMeshVel_);
-  w.putView("pb", pb_);
-  w.putView("points0", points0_);
-  w.putView("dpFinal", dpFinal_);
-  w.putView("pressureMatrix", Ap_.values);
+  if (gradUCurrent_) w.putView("gradU", gradU_, io::Entity::Cells);
+  w.putView("phi", phi_, io::Entity::FaceFluxes);
+  w.putView("meshPhi", meshPhi_, io::Entity::FaceFluxes);
+  w.putView("dphi", dphi_, io::Entity::FaceFluxes);
+  w.putView("dphi0", dphi0_, io::Entity::FaceFluxes);
+  w.putView("dphi00", dphi00_, io::Entity::FaceFluxes);
+  w.putView("sweptNew", sweptNew_, io::Entity::FaceFluxes);
+  w.putView("sweptOld", sweptOld_, io::Entity::FaceFluxes);
+  w.putView("Ub", Ub_, io::Entity::BoundaryFaces);
+  w.putView("faceMeshVelocity", faceMeshVel_, io::Entity::BoundaryFaces);
+  w.putView("pb", pb_, io::Entity::BoundaryFaces);
+  w.putView("points0", points0_, io::Entity::Nodes);
+  w.putView("dpFinal", dpFinal_, io::Entity::Cells);
+  w.putView("pressureMatrix", Ap_.values, io::Entity::Part);
   w.put("time", std::vector<double>{t_, dt_, dt0_, c1_, c0_, c00_});
   w.putInt("steps", nSteps_);
   // The levels a closed domain and closed regions are pinned at (a coupling moves them).
@@ -661,8 +661,14 @@ void FluidSolver::loadState(const io::StateReader& r) {
   bc_.loadState(r.sub("boundaryConditions"));
   // The preconditioner's replay writes Ap_'s values: they are read back after it.
   pressureLattice_ = nullptr;
-  linear_.loadPressurePreconditioner(r.sub("pressurePreconditioner"), exec_, pressureMatrix());
-  r.getView("pressureMatrix", Ap_.values);
+  if (r.has("pressureMatrix")) {
+    linear_.loadPressurePreconditioner(r.sub("pressurePreconditioner"), exec_, pressureMatrix());
+    r.getView("pressureMatrix", Ap_.values);
+  } else {
+    // A checkpoint carried to another decomposition (core/io/Redistribute) has no matrix: the
+    // first pressure solve assembles it and sets its preconditioner up afresh.
+    pressureRefreshDue_ = true;
+  }
   stepStart_.valid = false;
   exec_.fence();
 }

@@ -104,6 +104,8 @@ class FluidSolver {
   void saveState(io::StateWriter& w) const;
   /// \brief Read what saveState wrote, into a solver built from the same options on the same mesh
   /// whose points are already where they were when it was saved: the run then continues bitwise.
+  /// Without "pressureMatrix" (a checkpoint carried to another decomposition) the pressure matrix
+  /// and its preconditioner are rebuilt by the first solve: the run continues to solver tolerance.
   void loadState(const io::StateReader& r);
 
   // --- boundary input ------------------------------------------------------------------------

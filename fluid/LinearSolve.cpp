@@ -115,8 +115,8 @@ void LinearSolver::savePressurePreconditioner(io::StateWriter& w) const {
   w.putInt("setupSweeps", h.setupSweeps);
   w.putInt("refreshSweeps", h.refreshSweeps);
   w.putInt("sweeps", h.sweeps);
-  w.putView("setupValues", h.setupValues);
-  w.putView("refreshValues", h.refreshed ? h.refreshValues : RealView());
+  w.putView("setupValues", h.setupValues, io::Entity::Part);
+  w.putView("refreshValues", h.refreshed ? h.refreshValues : RealView(), io::Entity::Part);
 }
 
 void LinearSolver::loadPressurePreconditioner(const io::StateReader& r, const ExecSpace& exec, const CsrMatrix& A) {

@@ -23,8 +23,8 @@ bool RunningMean::accumulate(const ExecSpace& exec, real stepEnd, real dt, const
 
 void RunningMean::saveState(io::StateWriter& w) const {
   w.putReal("averagedTime", total_);
-  w.putView("U", U_);
-  w.putView("p", p_);
+  w.putView("U", U_, io::Entity::Cells);
+  w.putView("p", p_, io::Entity::Cells);
 }
 
 void RunningMean::loadState(const io::StateReader& r) {

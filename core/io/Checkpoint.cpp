@@ -36,6 +36,10 @@ void StateWriter::write(const std::string& name, const std::vector<std::int64_t>
   file_->write(group_ + "/" + name, v, dims);
 }
 
+void StateWriter::tag(const std::string& name, Entity rows) {
+  file_->write(entityTagPath(group_ + "/" + name), std::vector<std::int64_t>{static_cast<std::int64_t>(rows)}, {1});
+}
+
 bool StateReader::has(const std::string& name) const { return file_->has(group_ + "/" + name); }
 
 std::vector<std::size_t> StateReader::shape(const std::string& name) const {

@@ -18,6 +18,21 @@
 
 namespace mfsi::io {
 
+/// \brief What the rows of a checkpointed array belong to, so that a checkpoint written on one
+/// decomposition of the mesh can continue on another (core/io/Redistribute): a tagged array is
+/// carried by global id, an untagged one is the same on every rank and copied as it is.
+enum class Entity {
+  Cells,          ///< one row per local cell (owned, then ghosts)
+  FaceFluxes,     ///< one row per local face, oriented: the sign changes with the face's direction
+  BoundaryFaces,  ///< one row per local boundary face (face nInternalFaces + row), outward
+  Nodes,          ///< one row per local node
+  Part,           ///< depends on how the mesh is cut (a matrix's values): rebuilt on another one
+  RankOwn         ///< may differ between ranks and steers nothing (a wall time): rank 0's is carried
+};
+
+/// Where a checkpoint records the Entity of the dataset at `path` ("/modules/fluid/solver/U").
+inline std::string entityTagPath(const std::string& path) { return "/entities" + path; }
+
 /// \brief Writes named values under one group of a checkpoint.
 class StateWriter {
  public:
@@ -50,6 +65,16 @@ class StateWriter {
       write(name, out, dims);
     }
   }
+
+  /// The same, with the Entity its rows belong to (recorded beside it, see entityTagPath).
+  template <class View>
+  void putView(const std::string& name, const View& v, Entity rows) {
+    putView(name, v);
+    tag(name, rows);
+  }
+
+  /// Record the Entity of a dataset written under this group (what putView with one does).
+  void tag(const std::string& name, Entity rows);
 
   const std::string& group() const { return group_; }
 

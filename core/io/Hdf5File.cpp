@@ -166,6 +166,18 @@ Hdf5File Hdf5File::create(const std::string& path) {
   return f;
 }
 
+Hdf5File Hdf5File::scratch(const std::string& name) {
+  quietHdf5();
+  Hdf5File f;
+  f.path_ = name;
+  Handle fapl(H5Pcreate(H5P_FILE_ACCESS), H5Pclose);
+  if (fapl.id < 0 || H5Pset_fapl_core(fapl.id, kCoreIncrement, 0) < 0)
+    throw OutputError("cannot create '" + name + "' in memory (HDF5: the in-memory file driver)");
+  f.file_ = H5Fcreate(name.c_str(), H5F_ACC_TRUNC, H5P_DEFAULT, fapl.id);
+  if (f.file_ < 0) throw OutputError("cannot create '" + name + "' in memory (HDF5)");
+  return f;
+}
+
 Hdf5File Hdf5File::openRead(const std::string& path) {
   quietHdf5();
   Hdf5File f;
@@ -205,12 +217,12 @@ void Hdf5File::close() noexcept {
 }
 
 void Hdf5File::write(const std::string& dataset, const std::vector<double>& data, const std::vector<std::size_t>& dims) {
-  writeDataset(file_, writing_, dataset, data, dims, H5T_IEEE_F64LE, H5T_NATIVE_DOUBLE);
+  writeDataset(file_, writing_.empty() ? path_ : writing_, dataset, data, dims, H5T_IEEE_F64LE, H5T_NATIVE_DOUBLE);
 }
 
 void Hdf5File::write(const std::string& dataset, const std::vector<std::int64_t>& data,
                      const std::vector<std::size_t>& dims) {
-  writeDataset(file_, writing_, dataset, data, dims, H5T_STD_I64LE, H5T_NATIVE_INT64);
+  writeDataset(file_, writing_.empty() ? path_ : writing_, dataset, data, dims, H5T_STD_I64LE, H5T_NATIVE_INT64);
 }
 
 void Hdf5File::writeAttribute(const std::string& name, double value) {
@@ -296,6 +308,13 @@ std::vector<std::int64_t> Hdf5File::readInts(const std::string& dataset, std::ve
     fail(path_, "read dataset '" + dataset + "'");
   if (dims) *dims = shape;
   return data;
+}
+
+bool Hdf5File::holdsIntegers(const std::string& dataset) const {
+  Handle dset(openDataset(dataset, nullptr), H5Dclose);
+  Handle type(H5Dget_type(dset.id), H5Tclose);
+  if (type.id < 0) fail(path_, "read the type of dataset '" + dataset + "'");
+  return H5Tget_class(type.id) == H5T_INTEGER;
 }
 
 double Hdf5File::readAttribute(const std::string& name) const {

@@ -21,6 +21,9 @@ class Hdf5File {
   /// Start a new file that will appear at `path` on commit (an existing file there stays until
   /// then). Throws OutputError naming the path when the file cannot be created.
   static Hdf5File create(const std::string& path);
+  /// A file in memory alone, named `name` in messages: written and read like any other, never
+  /// on disk (commit() refuses it). What a checkpoint carried to another decomposition is built in.
+  static Hdf5File scratch(const std::string& name);
   /// Open an existing file for reading. Throws OutputError naming the path.
   static Hdf5File openRead(const std::string& path);
 
@@ -45,6 +48,8 @@ class Hdf5File {
   bool has(const std::string& dataset) const;
   /// Every dataset of the file by its path ("/modules/fluid/U"), sorted.
   std::vector<std::string> datasets() const;
+  /// Whether a dataset holds integers (else doubles). Throws OutputError when absent.
+  bool holdsIntegers(const std::string& dataset) const;
   /// The shape of a dataset. Throws OutputError when absent.
   std::vector<std::size_t> shape(const std::string& dataset) const;
 

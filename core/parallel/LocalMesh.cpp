@@ -3,6 +3,8 @@
 #include "core/Error.hpp"
 
 #include <algorithm>
+#include <array>
+#include <unordered_map>
 
 namespace mfsi {
 
@@ -200,6 +202,55 @@ LocalMeshPart localMeshPart(const HexMesh& global, const std::vector<int>& cellR
     in.patches.push_back(std::move(ps));
   }
   return part;
+}
+
+namespace {
+using FaceKey = std::array<gid_t, 4>;
+struct FaceKeyHash {
+  std::size_t operator()(const FaceKey& k) const {
+    std::size_t h = 1469598103934665603ull;
+    for (gid_t v : k) h = (h ^ static_cast<std::size_t>(v)) * 1099511628211ull;
+    return h;
+  }
+};
+FaceKey faceKey(const Kokkos::View<const lid_t* [4], Kokkos::HostSpace>& fn, lid_t f,
+                const Kokkos::View<const gid_t*, Kokkos::HostSpace>& nodeGid) {
+  FaceKey k{nodeGid(fn(f, 0)), nodeGid(fn(f, 1)), nodeGid(fn(f, 2)), nodeGid(fn(f, 3))};
+  std::sort(k.begin(), k.end());
+  return k;
+}
+}  // namespace
+
+std::vector<std::int64_t> globalFaceIds(const HexMesh& part, const HexMesh& global) {
+  using HostGid = Kokkos::View<const gid_t*, Kokkos::HostSpace>;
+  using HostIdx = Kokkos::View<const lid_t*, Kokkos::HostSpace>;
+  using HostQuad = Kokkos::View<const lid_t* [4], Kokkos::HostSpace>;
+  const HostQuad gfn = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), global.faceNodes());
+  const HostIdx gown = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), global.faceOwner());
+  const HostGid gnid = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), global.nodeGlobalIds());
+  const HostGid gcid = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), global.cellGlobalIds());
+  // A face's nodes name it, but for a baffle's two sides: those share nodes and differ in owner.
+  std::unordered_map<FaceKey, std::array<lid_t, 2>, FaceKeyHash> byNodes;
+  byNodes.reserve(static_cast<std::size_t>(global.nFaces()));
+  for (lid_t f = 0; f < global.nFaces(); ++f) {
+    auto [it, fresh] = byNodes.try_emplace(faceKey(gfn, f, gnid), std::array<lid_t, 2>{f, -1});
+    if (!fresh) it->second[1] = f;
+  }
+  const HostQuad pfn = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), part.faceNodes());
+  const HostIdx pown = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), part.faceOwner());
+  const HostGid pnid = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), part.nodeGlobalIds());
+  const HostGid pcid = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), part.cellGlobalIds());
+  std::vector<std::int64_t> ids(static_cast<std::size_t>(part.nFaces()));
+  for (lid_t f = 0; f < part.nFaces(); ++f) {
+    const auto it = byNodes.find(faceKey(pfn, f, pnid));
+    MFSI_CHECK(it != byNodes.end(), "globalFaceIds: face " << f << " of " << part.source() << " is not in "
+                                                           << global.source());
+    const gid_t owner = pcid(pown(f));
+    lid_t g = it->second[0];
+    if (it->second[1] >= 0 && gcid(gown(g)) != owner) g = it->second[1];  // the baffle's other side
+    ids[f] = gcid(gown(g)) == owner ? g : -(static_cast<std::int64_t>(g) + 1);
+  }
+  return ids;
 }
 
 }  // namespace mfsi

@@ -13,6 +13,7 @@
 /// start-up of today's runs and is what a parallel mesh reader will replace.
 #include "core/HexMesh.hpp"
 
+#include <cstdint>
 #include <string>
 #include <vector>
 
@@ -44,5 +45,12 @@ struct LocalMeshPart {
 /// with `ghostLayers` layers of face-neighbour ghost cells (>= 1).
 LocalMeshPart localMeshPart(const HexMesh& global, const std::vector<int>& cellRank, int ranks, int rank,
                             int ghostLayers = 1);
+
+/// \brief The global face of `global` that each face of `part` is (`part`: a rank's part of it,
+/// with its cells' and nodes' global ids; or `global` itself): `g` when the two point the same way
+/// (the same owner cell), `-(g + 1)` when the part's face points the other way. A face of the
+/// processor patch is the global internal face it lies on; a baffle's side, the side of the same
+/// cell. Matched by the faces' global node ids, on the host.
+std::vector<std::int64_t> globalFaceIds(const HexMesh& part, const HexMesh& global);
 
 }  // namespace mfsi

@@ -413,9 +413,10 @@ MotionReport MeshSmoother::move(const ExecSpace& exec) {
 }
 
 void MeshSmoother::saveState(io::StateWriter& w) const {
-  w.putView("displacement", d_);
-  w.putView("accepted", good_);
-  if (lastBase_.extent(0) > 0) w.putView("lastBase", lastBase_);  // the next motion's warm start
+  w.putView("displacement", d_, io::Entity::Nodes);
+  w.putView("accepted", good_, io::Entity::Nodes);
+  // The next motion's warm start.
+  if (lastBase_.extent(0) > 0) w.putView("lastBase", lastBase_, io::Entity::Nodes);
 }
 
 void MeshSmoother::loadState(const io::StateReader& r) {

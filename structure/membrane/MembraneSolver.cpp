@@ -940,6 +940,7 @@ void MembraneSolver::saveState(io::StateWriter& w) const {
   report.putInt("lineSearchSteps", last_.lineSearchSteps);
   report.putReal("relativeResidual", last_.relativeResidual);
   report.putReal("seconds", last_.seconds);
+  report.tag("seconds", io::Entity::RankOwn);
   if (volume_.active) {
     w.putReal("volumeMultiplier", volume_.lambda);
     w.putReal("volumeMultiplierCommitted", lambdaCommitted_);
