@@ -17,7 +17,7 @@
 #   repeats the METIS run bit for bit; a map with a bad line is refused naming file and line.
 # - Checkpoints on 2 ranks (one file per rank, the oldest pruned on every rank): a restart on 2
 #   ranks from the middle of the cavity run gives the same steps bit for bit; a restart on 3 ranks
-#   is refused with one message (exit 2).
+#   (the state carried to another decomposition) ends where the uninterrupted run does, to 1e-9.
 # With SHORT (the instrumented builds) the 4-rank cavity is left out and the balloon stops at
 # t = 0.5 s.
 find_program(MPIEXEC mpiexec)
@@ -149,13 +149,10 @@ list(LENGTH rest nr)
 if(NOT nr EQUAL 4 OR NOT tail STREQUAL rest)
   message(SEND_ERROR "a restart on 2 ranks from step 6 differs from the run it continues (${nr} rows):\n${rest}\n${tail}")
 endif()
-execute_process(COMMAND ${MPIEXEC} --allow-run-as-root --oversubscribe -np 3 ${MFSI} run --restart ${WORK}/saved
-  --out ${WORK}/three RESULT_VARIABLE rc OUTPUT_VARIABLE o ERROR_VARIABLE e)
-string(REGEX MATCHALL "written by a run on 2 rank" lines "${e}")
-list(LENGTH lines nl)
-if(NOT rc EQUAL 2 OR NOT nl EQUAL 1)
-  message(SEND_ERROR "a restart on 3 ranks of a 2-rank checkpoint: exit ${rc}, ${nl} messages:\n${e}")
-endif()
+# A restart on 3 ranks of the 2-rank checkpoint: the state carried by global ids, the end of the
+# run as the uninterrupted one's to the solvers' tolerance (measured: 12 digits).
+run(three 3 --restart ${WORK}/saved/checkpoints/checkpoint_000000006.h5)
+same(saved three 1e-9 membrane.bottom.centreUy fluid.max_velocity)
 
 # The map `mfsi partition` writes is the one a run computes.
 execute_process(COMMAND ${MFSI} partition ${cavity} -n 2 --out ${WORK}/map2.txt RESULT_VARIABLE rc OUTPUT_VARIABLE o
