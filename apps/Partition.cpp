@@ -29,7 +29,7 @@ int commandPartition(const std::string& scene, const std::vector<std::string>& s
     const mfsi::HexMesh mesh = mfsi::buildMesh(cfg.child("mesh"));
     mfsi::PartitionOptions opt;
     opt.parts = ranks;
-    opt.keepTogether = mfsi::membraneCellGroups(cfg, mesh);
+    opt.keepTogether = mfsi::cellGroupsKeptTogether(cfg, mesh);
     part = mfsi::partitionGraph(mfsi::cellDualGraph(mesh), opt);
     for (int r = 0; r < ranks; ++r) parts.push_back(mfsi::localMeshPart(mesh, part.cellRank, ranks, r));
   } catch (const mfsi::InputError& e) {

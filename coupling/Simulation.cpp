@@ -135,27 +135,31 @@ Simulation::Simulation(const SceneConfig& scene, const std::string& partitionFil
     throw InputError(scene.where(), "the scene names nothing to simulate: give at least a 'mesh' or a physics section");
 }
 
-std::vector<std::vector<lid_t>> membraneCellGroups(const SceneConfig& scene, const HexMesh& mesh) {
+std::vector<std::vector<lid_t>> cellGroupsKeptTogether(const SceneConfig& scene, const HexMesh& mesh,
+                                                       std::vector<std::string>* names) {
   std::vector<std::vector<lid_t>> groups;
-  if (!scene.has("membranes")) return groups;
   auto owner = Kokkos::create_mirror_view_and_copy(HostSpace(), mesh.faceOwner());
-  for (std::size_t i = 0; i < scene.size("membranes"); ++i) {
-    const std::string m = "membranes." + std::to_string(i) + ".mesh.";
-    std::vector<std::string> patches;
-    if (scene.has(m + "baffles.patch")) {
-      const std::string b = scene.get<std::string>(m + "baffles.patch");
-      patches = {b + "_master", b + "_slave"};
-    } else if (scene.has(m + "boundaryPatch.patch")) {
-      patches = {scene.get<std::string>(m + "boundaryPatch.patch")};
-    }
+  auto add = [&](const std::vector<int>& patches, const std::string& what) {
     std::vector<lid_t> cells;
-    for (const auto& name : patches) {
-      const int p = mesh.findPatch(name);
-      if (p < 0) continue;  // the membrane's set-up names it
+    for (int p : patches) {
       const auto& patch = mesh.patches()[p];
       for (lid_t f = patch.start; f < patch.start + patch.size; ++f) cells.push_back(owner(f));
     }
-    if (!cells.empty()) groups.push_back(std::move(cells));
+    if (cells.empty()) return;
+    groups.push_back(std::move(cells));
+    if (names) names->push_back(what);
+  };
+  const auto& patches = mesh.patches();
+  for (std::size_t p = 0; p < patches.size(); ++p)
+    if (patches[p].kind == PatchKind::BaffleMaster)
+      add({static_cast<int>(p), patches[p].pairedPatch}, "baffle '" + patches[p].name + "'");
+  if (!scene.has("membranes")) return groups;
+  for (std::size_t i = 0; i < scene.size("membranes"); ++i) {
+    const std::string m = "membranes." + std::to_string(i) + ".mesh.boundaryPatch.patch";
+    if (!scene.has(m)) continue;  // a baffle membrane: its baffle's group above
+    const std::string name = scene.get<std::string>(m);
+    const int p = mesh.findPatch(name);
+    if (p >= 0) add({p}, "membrane patch '" + name + "'");  // else the membrane's set-up names it
   }
   return groups;
 }
@@ -171,10 +175,19 @@ void Simulation::decompose(const SceneConfig& scene, const std::string& partitio
   if (partitionFile.empty()) {
     PartitionOptions opt;
     opt.parts = ranks_;
-    opt.keepTogether = membraneCellGroups(scene, mesh_);
+    opt.keepTogether = cellGroupsKeptTogether(scene, mesh_);
     part = partitionGraph(cellDualGraph(mesh_), opt);
   } else {
     part.cellRank = readPartitionMap(partitionFile, static_cast<std::size_t>(mesh_.nCells()), ranks_);
+    std::vector<std::string> names;
+    const auto groups = cellGroupsKeptTogether(scene, mesh_, &names);
+    for (std::size_t g = 0; g < groups.size(); ++g)
+      for (lid_t c : groups[g])
+        if (part.cellRank[c] != part.cellRank[groups[g][0]])
+          throw InputError(partitionFile + ": the cells along " + names[g] + " are on ranks " +
+                           std::to_string(part.cellRank[groups[g][0]]) + " (cell " + std::to_string(groups[g][0]) +
+                           ") and " + std::to_string(part.cellRank[c]) + " (cell " + std::to_string(c) +
+                           "); a membrane's or a baffle's cells stay on one rank (mfsi partition writes such a map)");
   }
   const LocalMeshPart lp = localMeshPart(mesh_, part.cellRank, ranks_, rank_);
   std::uint64_t h = 1469598103934665603ull;  // FNV-1a over the map

@@ -53,10 +53,13 @@ struct RunResult {
   std::string steadyStateMissed;
 };
 
-/// \brief The cells along every membrane a scene cuts from its mesh (the owners of its baffle's
-/// faces, both sides, or of its wall patch's faces), one group per membrane: what a decomposition
-/// keeps on one rank (the seed's singleProcessorFaceSets).
-std::vector<std::vector<lid_t>> membraneCellGroups(const SceneConfig& scene, const HexMesh& mesh);
+/// \brief What a decomposition keeps on one rank (the seed's singleProcessorFaceSets): the cells
+/// along every membrane a scene cuts from its mesh (the owners of its wall patch's faces) and
+/// along every baffle of the mesh, a membrane or a fixed wall (the owners of its faces, both
+/// sides: a baffle face is one face of two cells, and a rank holds it only with both). One group
+/// per membrane or baffle; `names` (optional) receives what each group is, for messages.
+std::vector<std::vector<lid_t>> cellGroupsKeptTogether(const SceneConfig& scene, const HexMesh& mesh,
+                                                       std::vector<std::string>* names = nullptr);
 
 class Simulation {
  public:

@@ -325,8 +325,11 @@ void BoundaryConditions::saveState(io::StateWriter& w) const {
   w.putView("velocity", velocity_, io::Entity::BoundaryFaces);
   w.putView("pressure", pressure_, io::Entity::BoundaryFaces);
   w.putView("external", external_, io::Entity::BoundaryFaces);
+  // One pair per patch of the whole mesh (a rank's processor patch is its own, and a restart on
+  // another rank count has another), in the mesh's patch order.
   std::vector<double> patchValues;
-  for (const ResolvedPatch& rp : patches_) patchValues.insert(patchValues.end(), {rp.currentPressure, rp.currentFlowRate});
+  for (const ResolvedPatch& rp : patches_)
+    if (rp.name != kProcessorPatch) patchValues.insert(patchValues.end(), {rp.currentPressure, rp.currentFlowRate});
   w.put("patchPressureAndFlowRate", patchValues);
 }
 
@@ -337,10 +340,15 @@ void BoundaryConditions::loadState(const io::StateReader& r) {
   r.getView("external", external_);
   Kokkos::deep_copy(hVelocity_, velocity_);
   Kokkos::deep_copy(hPressure_, pressure_);
-  const auto patchValues = r.doubles("patchPressureAndFlowRate", 2 * static_cast<long long>(patches_.size()));
-  for (std::size_t i = 0; i < patches_.size(); ++i) {
-    patches_[i].currentPressure = patchValues[2 * i];
-    patches_[i].currentFlowRate = patchValues[2 * i + 1];
+  long long named = 0;
+  for (const ResolvedPatch& rp : patches_) named += rp.name != kProcessorPatch;
+  const auto patchValues = r.doubles("patchPressureAndFlowRate", 2 * named);
+  std::size_t i = 0;
+  for (ResolvedPatch& rp : patches_) {
+    if (rp.name == kProcessorPatch) continue;
+    rp.currentPressure = patchValues[2 * i];
+    rp.currentFlowRate = patchValues[2 * i + 1];
+    ++i;
   }
 }
 

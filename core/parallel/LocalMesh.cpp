@@ -213,8 +213,8 @@ struct FaceKeyHash {
     return h;
   }
 };
-FaceKey faceKey(const Kokkos::View<const lid_t* [4], Kokkos::HostSpace>& fn, lid_t f,
-                const Kokkos::View<const gid_t*, Kokkos::HostSpace>& nodeGid) {
+template <class Quads, class Gids>
+FaceKey faceKey(const Quads& fn, lid_t f, const Gids& nodeGid) {
   FaceKey k{nodeGid(fn(f, 0)), nodeGid(fn(f, 1)), nodeGid(fn(f, 2)), nodeGid(fn(f, 3))};
   std::sort(k.begin(), k.end());
   return k;
@@ -222,13 +222,10 @@ FaceKey faceKey(const Kokkos::View<const lid_t* [4], Kokkos::HostSpace>& fn, lid
 }  // namespace
 
 std::vector<std::int64_t> globalFaceIds(const HexMesh& part, const HexMesh& global) {
-  using HostGid = Kokkos::View<const gid_t*, Kokkos::HostSpace>;
-  using HostIdx = Kokkos::View<const lid_t*, Kokkos::HostSpace>;
-  using HostQuad = Kokkos::View<const lid_t* [4], Kokkos::HostSpace>;
-  const HostQuad gfn = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), global.faceNodes());
-  const HostIdx gown = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), global.faceOwner());
-  const HostGid gnid = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), global.nodeGlobalIds());
-  const HostGid gcid = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), global.cellGlobalIds());
+  const auto gfn = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), global.faceNodes());
+  const auto gown = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), global.faceOwner());
+  const auto gnid = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), global.nodeGlobalIds());
+  const auto gcid = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), global.cellGlobalIds());
   // A face's nodes name it, but for a baffle's two sides: those share nodes and differ in owner.
   std::unordered_map<FaceKey, std::array<lid_t, 2>, FaceKeyHash> byNodes;
   byNodes.reserve(static_cast<std::size_t>(global.nFaces()));
@@ -236,10 +233,10 @@ std::vector<std::int64_t> globalFaceIds(const HexMesh& part, const HexMesh& glob
     auto [it, fresh] = byNodes.try_emplace(faceKey(gfn, f, gnid), std::array<lid_t, 2>{f, -1});
     if (!fresh) it->second[1] = f;
   }
-  const HostQuad pfn = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), part.faceNodes());
-  const HostIdx pown = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), part.faceOwner());
-  const HostGid pnid = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), part.nodeGlobalIds());
-  const HostGid pcid = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), part.cellGlobalIds());
+  const auto pfn = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), part.faceNodes());
+  const auto pown = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), part.faceOwner());
+  const auto pnid = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), part.nodeGlobalIds());
+  const auto pcid = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), part.cellGlobalIds());
   std::vector<std::int64_t> ids(static_cast<std::size_t>(part.nFaces()));
   for (lid_t f = 0; f < part.nFaces(); ++f) {
     const auto it = byNodes.find(faceKey(pfn, f, pnid));

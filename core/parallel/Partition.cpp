@@ -117,7 +117,7 @@ Partition partitionGraph(const CellGraph& graph, const PartitionOptions& options
     unitOf[c] = unitOf[r];
   }
   MFSI_CHECK(parts <= nUnits, "partition: " << parts << " ranks for " << nUnits
-                                            << " cells (after keeping each membrane's cells together): "
+                                            << " cells (after keeping each membrane's and baffle's cells together): "
                                                "use at most "
                                             << nUnits << " ranks");
   std::vector<idx_t> vwgt(nUnits, 0);

@@ -14,10 +14,12 @@
 #   membrane's centre displacement to 1e-8, the chamber's volume to 1e-10 and its pressure (the
 #   multiplier plus the fluid's mean load) to 1e-6 of one rank's (measured 1.4e-10, 2e-13, 5e-8).
 # - `mfsi partition` writes the map a run computes: the cavity run on 2 ranks with --partition
-#   repeats the METIS run bit for bit; a map with a bad line is refused naming file and line.
+#   repeats the METIS run bit for bit; a map with a bad line is refused naming file and line, a
+#   map that splits the membrane's cells over two ranks naming the membrane.
 # - Checkpoints on 2 ranks (one file per rank, the oldest pruned on every rank): a restart on 2
 #   ranks from the middle of the cavity run gives the same steps bit for bit; a restart on 3 ranks
-#   (the state carried to another decomposition) ends where the uninterrupted run does, to 1e-9.
+#   and on one (the state carried to another decomposition) ends where the uninterrupted run
+#   does, to 1e-9, as does one rank's checkpoint continued on 2 ranks.
 # With SHORT (the instrumented builds) the 4-rank cavity is left out and the balloon stops at
 # t = 0.5 s.
 find_program(MPIEXEC mpiexec)
@@ -68,7 +70,7 @@ endfunction()
 
 set(cavity flexible-cavity --set mesh.blocks.0.cells=[12,10,1] --set mesh.blocks.1.cells=[12,2,1]
   --set time.endTime=1 ${tight})
-run(cavity1 1 ${cavity})
+run(cavity1 1 ${cavity} --set output.checkpoint.everySteps=3)
 run(cavity2 2 ${cavity})
 run(cavity2again 2 ${cavity})
 set(compared cavity2)
@@ -152,7 +154,12 @@ endif()
 # A restart on 3 ranks of the 2-rank checkpoint: the state carried by global ids, the end of the
 # run as the uninterrupted one's to the solvers' tolerance (measured: 12 digits).
 run(three 3 --restart ${WORK}/saved/checkpoints/checkpoint_000000006.h5)
-same(saved three 1e-9 membrane.bottom.centreUy fluid.max_velocity)
+same(saved three 1e-9 membrane.bottom.centreUy fluid.max_velocity membrane.bottom.maxVonMises)
+# ... and on one rank (measured 4e-15), and one rank's checkpoint on 2 ranks (measured 3e-15).
+run(one 1 --restart ${WORK}/saved/checkpoints/checkpoint_000000006.h5)
+same(saved one 1e-9 membrane.bottom.centreUy fluid.max_velocity membrane.bottom.maxVonMises)
+run(two 2 --restart ${WORK}/cavity1/checkpoints/checkpoint_000000006.h5)
+same(cavity1 two 1e-9 membrane.bottom.centreUy fluid.max_velocity membrane.bottom.maxVonMises)
 
 # The map `mfsi partition` writes is the one a run computes.
 execute_process(COMMAND ${MFSI} partition ${cavity} -n 2 --out ${WORK}/map2.txt RESULT_VARIABLE rc OUTPUT_VARIABLE o
@@ -175,4 +182,17 @@ string(REGEX MATCHALL "bad.txt:5: '7' is not a rank" lines "${e}")
 list(LENGTH lines nl)
 if(NOT rc EQUAL 2 OR NOT nl EQUAL 1)
   message(SEND_ERROR "a map with a bad line 5: exit ${rc}, ${nl} messages:\n${e}")
+endif()
+# A map that puts the membrane's cells on two ranks is refused: a rank holds a membrane's (or a
+# baffle's) faces only with all of its cells.
+set(split "")
+foreach(c RANGE 143)
+  math(EXPR r "${c} % 2")
+  string(APPEND split "${r}\n")
+endforeach()
+file(WRITE ${WORK}/split.txt "${split}")
+execute_process(COMMAND ${MPIEXEC} --allow-run-as-root --oversubscribe -np 2 ${MFSI} run ${cavity}
+  --partition ${WORK}/split.txt --out ${WORK}/split RESULT_VARIABLE rc OUTPUT_VARIABLE o ERROR_VARIABLE e)
+if(NOT rc EQUAL 2 OR NOT e MATCHES "split.txt: the cells along membrane patch 'bottom' are on ranks")
+  message(SEND_ERROR "a map that splits the membrane: exit ${rc}\n${e}")
 endif()
