@@ -21,6 +21,8 @@ int commandPartition(const std::string& scene, const std::vector<std::string>& s
   mfsi::Partition part;
   std::string name;
   std::vector<mfsi::LocalMeshPart> parts;
+  std::vector<std::string> kept;
+  std::vector<std::vector<mfsi::lid_t>> groups;
   try {
     const fs::path file = resolveScene(scene);
     const auto cfg = mfsi::SceneConfig::load(file.string(), mfsi::sceneSchema(), sets);
@@ -29,7 +31,8 @@ int commandPartition(const std::string& scene, const std::vector<std::string>& s
     const mfsi::HexMesh mesh = mfsi::buildMesh(cfg.child("mesh"));
     mfsi::PartitionOptions opt;
     opt.parts = ranks;
-    opt.keepTogether = mfsi::cellGroupsKeptTogether(cfg, mesh);
+    groups = mfsi::cellGroupsKeptTogether(cfg, mesh, &kept);
+    opt.keepTogether = groups;
     part = mfsi::partitionGraph(mfsi::cellDualGraph(mesh), opt);
     for (int r = 0; r < ranks; ++r) parts.push_back(mfsi::localMeshPart(mesh, part.cellRank, ranks, r));
   } catch (const mfsi::InputError& e) {
@@ -52,6 +55,10 @@ int commandPartition(const std::string& scene, const std::vector<std::string>& s
               << (p.nodes.nLocal - p.nodes.nOwned) << std::setw(12) << p.cells.neighbours.size() << std::setw(10)
               << messages << std::setw(20) << bytes << "\n";
   }
+  // Each membrane (and baffle) is solved or held by the rank of its cells.
+  for (std::size_t g = 0; g < kept.size(); ++g)
+    std::cout << "on rank " << part.cellRank[groups[g][0]] << ": " << kept[g] << " (" << groups[g].size()
+              << " cells)\n";
   if (out.empty()) out = "results/" + name + "-partition" + std::to_string(ranks) + ".txt";
   const fs::path target(out), tmp = fs::path(out + ".part");
   std::error_code ec;

@@ -152,7 +152,8 @@ std::vector<std::vector<lid_t>> cellGroupsKeptTogether(const SceneConfig& scene,
   const auto& patches = mesh.patches();
   for (std::size_t p = 0; p < patches.size(); ++p)
     if (patches[p].kind == PatchKind::BaffleMaster)
-      add({static_cast<int>(p), patches[p].pairedPatch}, "baffle '" + patches[p].name + "'");
+      add({static_cast<int>(p), patches[p].pairedPatch},
+          "baffle '" + patches[p].name.substr(0, patches[p].name.rfind("_master")) + "'");
   if (!scene.has("membranes")) return groups;
   for (std::size_t i = 0; i < scene.size("membranes"); ++i) {
     const std::string m = "membranes." + std::to_string(i) + ".mesh.boundaryPatch.patch";

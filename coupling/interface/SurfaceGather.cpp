@@ -79,8 +79,18 @@ SurfaceGather::SurfaceGather(const HexMesh& whole, const HexMesh& part, MPI_Comm
     sd.tractionP = Real3View("mfsi::coupling::surface::pressureTraction", m);
     sd.tractionV = Real3View("mfsi::coupling::surface::viscousTraction", m);
   }
-  if (comm_ != MPI_COMM_NULL)
+  // The rank that owns every face of the surface (a decomposition keeps a membrane's cells on one
+  // rank), if one does.
+  long long mine = 0;
+  for (int o : owners) mine += o;
+  owner_ = mine == static_cast<long long>(owners.size()) ? 0 : -1;
+  if (comm_ != MPI_COMM_NULL) {
+    int rank = 0;
+    MPI_Comm_rank(comm_, &rank);
+    owner_ = mine == static_cast<long long>(owners.size()) ? rank : -1;
+    MPI_Allreduce(MPI_IN_PLACE, &owner_, 1, MPI_INT, MPI_MAX, comm_);
     MPI_Allreduce(MPI_IN_PLACE, owners.data(), static_cast<int>(owners.size()), MPI_INT, MPI_SUM, comm_);
+  }
   for (std::size_t k = 0; k < owners.size(); ++k)
     if (owners[k] != 1)
       throw InputError("coupling: face " + std::to_string(k % static_cast<std::size_t>(n)) + " of " + name +

@@ -36,6 +36,10 @@ class SurfaceGather {
   /// node the rank does not hold).
   const MembraneInterface& gatheredInterface() const { return iface_; }
 
+  /// The rank that owns every face of the surface (its cells' rank; 0 on one rank), or -1 when
+  /// its faces are spread over ranks.
+  int ownerRank() const { return owner_; }
+
   /// Pressure, vector area, area and centroid of every slot from `fluid` (collective).
   void gather(const ExecSpace& exec, const fluid::FluidSolver& fluid);
   /// The pressure and viscous traction of every slot (fluid::boundaryTraction; collective).
@@ -73,6 +77,7 @@ class SurfaceGather {
   lid_t nElements_ = 0;
   Side sides_[2];
   int nSides_ = 1;
+  int owner_ = -1;
   MembraneInterface iface_;
   RealView pressure_, areaMag_, buffer_;
   Real3View area_, centroid_, viscousFront_, viscousBack_;

@@ -73,6 +73,7 @@ FsiCoupling::FsiCoupling(const CouplingOptions& options, const SceneConfig& sect
     p.surface = coupling::SurfaceGather(whole_, mesh_, comm_, surf, surface,
                                         baffle ? coupling::InterfaceSide::Baffle : coupling::InterfaceSide::Patch);
     p.iface = p.surface.gatheredInterface();
+    if (comm_ != MPI_COMM_NULL) p.owner = p.surface.ownerRank();
     p.dynamic = po.analysis == MembraneAnalysis::Dynamic;
     if (options_.interfaceMass > 0) {
       if (!p.dynamic)
@@ -640,9 +641,19 @@ void FsiCoupling::solveStructure(double t1, double dt) {
     }
   }
   updateFrameInertia();  // the bodies' accelerations of this solve
+  // On several ranks each membrane is solved by the rank that owns its faces, the ranks' membranes
+  // at the same time; then every owner sends its answer to the others.
+  int rank = 0;
+  if (comm_ != MPI_COMM_NULL) MPI_Comm_rank(comm_, &rank);
   for (Panel& p : panels_) {
+    if (p.owner >= 0 && p.owner != rank) continue;
     MembraneSolver& s = p.module->solver();
-    const MembraneSolveReport rep = p.dynamic ? s.solveStep(dt) : s.solveStatic(t1);
+    p.report = p.dynamic ? s.solveStep(dt) : s.solveStatic(t1);
+  }
+  for (Panel& p : panels_)
+    if (p.owner >= 0) shareSolve(p, t1, dt);
+  for (Panel& p : panels_) {
+    const MembraneSolveReport& rep = p.report;
     if (!rep.converged || !std::isfinite(rep.relativeResidual)) {
       std::ostringstream os;
       os << p.module->name() << ": the structure solve did not converge in the step to t = " << t1 << " ("
@@ -653,6 +664,58 @@ void FsiCoupling::solveStructure(double t1, double dt) {
     }
   }
   ++last_.structureSolves;
+}
+
+void FsiCoupling::shareSolve(Panel& p, double t1, double dt) {
+  ScopedTimer timer(timers_, "coupling.structureShare");
+  MembraneSolver& s = p.module->solver();
+  int rank = 0;
+  MPI_Comm_rank(comm_, &rank);
+  const bool mine = rank == p.owner;
+  // The answer's Views (a step's trial state and the committed acceleration; a static solve's
+  // displacement), then the report and the multiplier, in one message.
+  std::vector<RealView> views;
+  if (p.dynamic) {
+    for (const RealView& v : s.stepResult()) views.push_back(v);
+  } else {
+    views.push_back(s.displacement());
+  }
+  std::size_t n = 0;
+  for (const RealView& v : views) n += v.extent(0);
+  constexpr std::size_t kReport = 7;
+  std::vector<double> buffer(n + kReport);
+  if (mine) {
+    std::size_t at = 0;
+    for (const RealView& v : views) {
+      auto h = Kokkos::create_mirror_view_and_copy(HostSpace(), v);
+      std::copy(h.data(), h.data() + h.extent(0), buffer.begin() + static_cast<std::ptrdiff_t>(at));
+      at += h.extent(0);
+    }
+    const MembraneSolveReport& r = p.report;
+    const double tail[kReport] = {r.converged ? 1.0 : 0.0, static_cast<double>(r.iterations),
+                                  static_cast<double>(r.linearIterations), static_cast<double>(r.lineSearchSteps),
+                                  r.relativeResidual, r.seconds, s.volumeConstraint().lambda};
+    std::copy(tail, tail + kReport, buffer.begin() + static_cast<std::ptrdiff_t>(n));
+  }
+  MPI_Bcast(buffer.data(), static_cast<int>(buffer.size()), MPI_DOUBLE, p.owner, comm_);
+  if (mine) return;
+  std::size_t at = 0;
+  for (const RealView& v : views) {
+    Kokkos::View<const double*, HostSpace, Kokkos::MemoryTraits<Kokkos::Unmanaged>> h(buffer.data() + at, v.extent(0));
+    Kokkos::deep_copy(v, h);
+    at += v.extent(0);
+  }
+  MembraneSolveReport& r = p.report;
+  r.converged = buffer[n] != 0;
+  r.iterations = static_cast<int>(buffer[n + 1]);
+  r.linearIterations = static_cast<int>(buffer[n + 2]);
+  r.lineSearchSteps = static_cast<int>(buffer[n + 3]);
+  r.relativeResidual = buffer[n + 4];
+  r.seconds = buffer[n + 5];
+  if (p.dynamic)
+    s.adoptStep(dt, r, buffer[n + 6]);
+  else
+    s.adoptStatic(t1, r);
 }
 
 void FsiCoupling::gatherTrial(InterfaceVector& xt) const {
@@ -973,6 +1036,13 @@ void FsiCoupling::addMetrics(std::map<std::string, double>& m) const {
   m["coupling.steps"] = double(steps_);
   m["coupling.mean_iterations"] = steps_ > 0 ? double(iterationsTotal_) / double(steps_) : 0.0;
   m["coupling.max_iterations"] = maxIterations_;
+  // Which rank solves each membrane (-1: every rank), and how many rank 0 solves.
+  int solvedOnRank0 = 0;
+  for (const Panel& p : panels_) {
+    m["coupling." + p.module->name() + ".solved_on_rank"] = comm_ == MPI_COMM_NULL ? 0 : p.owner;
+    solvedOnRank0 += p.owner <= 0 ? 1 : 0;
+  }
+  m["coupling.membranes_solved_on_rank0"] = solvedOnRank0;
   m["coupling.unconverged_steps"] = double(unconvergedSteps_);
   m["coupling.min_scaled_jacobian"] = minJacobian_;
   m["coupling.cut_backs"] = double(cutBacksTotal_);

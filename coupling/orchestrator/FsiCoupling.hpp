@@ -137,6 +137,10 @@ class FsiCoupling final : public Module {
     bool haveLastStep = false;
     bool mounted = false;            ///< on moving bodies (parentBodyPatches): FEM relative to them
     coupling::ParentFrames parents;  ///< mounted: each node's body and the bodies' motions
+    /// On several ranks: the rank that solves the membrane (the owner of its faces), which sends
+    /// its answer to the others; -1: every rank solves it (one rank, or its faces spread).
+    int owner = -1;
+    MembraneSolveReport report;  ///< of the last structure solve
   };
   /// A rigid body of the coupling and the fluid patches it carries.
   struct CoupledBody {
@@ -162,6 +166,8 @@ class FsiCoupling final : public Module {
   void extrapolateLoads();
   void updateFrameInertia();
   void solveStructure(double t1, double dt);
+  /// Every rank but the panel's owner receives the owner's answer to the last solve (collective).
+  void shareSolve(Panel& p, double t1, double dt);
   void gatherTrial(coupling::InterfaceVector& xt) const;
   /// The membranes (and bodies) to the iterate x; a membrane that closes a chamber first moves x
   /// onto its volume constraint (x is updated).

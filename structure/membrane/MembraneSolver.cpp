@@ -640,6 +640,20 @@ void MembraneSolver::commitStep() {
 
 void MembraneSolver::discardStep() { trial_ = {}; }
 
+void MembraneSolver::adoptStep(real dt, const MembraneSolveReport& report, real lambda) {
+  MFSI_CHECK(dt > 0, "membrane: adoptStep needs dt > 0");
+  trial_.valid = true;
+  trial_.dt = dt;
+  haveAcceleration_ = true;  // the owner's, received with the step
+  volume_.lambda = lambda;
+  last_ = report;
+}
+
+void MembraneSolver::adoptStatic(real time, const MembraneSolveReport& report) {
+  time_ = time;
+  last_ = report;
+}
+
 RealView MembraneSolver::nodalMass() {
   if (nodalMass_.extent(0) == static_cast<std::size_t>(mesh_.nNodes())) return nodalMass_;
   const lid_t n = mesh_.nNodes();

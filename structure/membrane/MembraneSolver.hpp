@@ -23,6 +23,7 @@
 #include "structure/membrane/MembraneElements.hpp"
 #include "structure/membrane/MembraneLinearSolve.hpp"
 
+#include <array>
 #include <map>
 #include <string>
 
@@ -104,6 +105,19 @@ class MembraneSolver {
   void commitStep();
   /// \brief Forget the trial state (the next solveStep starts from the predictor).
   void discardStep();
+
+  // --- a membrane solved on another rank ------------------------------------------------------
+  /// \brief The Views a `solveStep` leaves its answer in: the trial displacement, velocity and
+  /// acceleration, and the committed acceleration (which the first solve computes). A solver of
+  /// the same membrane that did not run the solve (a rank mirroring a membrane its owner rank
+  /// solves) receives the owner's values into its own four, then calls `adoptStep`: it then holds
+  /// the owner's trial state bit for bit, and a `setTrialDisplacement` or `commitStep` on both
+  /// gives the same state.
+  std::array<RealView, 4> stepResult() const { return {uTrial_, v1_, a1_, a_}; }
+  /// The step of size dt was solved elsewhere with `report` and the multiplier `lambda`.
+  void adoptStep(real dt, const MembraneSolveReport& report, real lambda);
+  /// A `solveStatic` at `time` was solved elsewhere (its displacement received into displacement()).
+  void adoptStatic(real time, const MembraneSolveReport& report);
 
   /// The volume constraint of `solveStep` (inactive by default). Static solves refuse an active one.
   MembraneVolumeConstraint& volumeConstraint() { return volume_; }

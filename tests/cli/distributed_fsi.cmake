@@ -13,6 +13,8 @@
 # - The balloon (a closed chamber: a membrane with a volume constraint) to t = 2 s: on 2 ranks the
 #   membrane's centre displacement to 1e-8, the chamber's volume to 1e-10 and its pressure (the
 #   multiplier plus the fluid's mean load) to 1e-6 of one rank's (measured 1.4e-10, 2e-13, 5e-8).
+# - Two screens far apart: each solved by its own rank only (one per rank), the answer sent to
+#   the other: the same as one rank's to 1e-9.
 # - `mfsi partition` writes the map a run computes: the cavity run on 2 ranks with --partition
 #   repeats the METIS run bit for bit; a map with a bad line is refused naming file and line, a
 #   map that splits the membrane's cells over two ranks naming the membrane.
@@ -129,6 +131,20 @@ run(balloon2 2 ${balloon} ${tight})
 same(balloon1 balloon2 1e-8 membrane.top.centreUy)
 same(balloon1 balloon2 1e-10 coupling.chamber_volume)
 same(balloon1 balloon2 1e-6 coupling.chamber_pressure)
+
+# Two screens, each solved only by the rank that owns its cells (one on each rank), the other
+# rank receiving the answer: the same as one rank's to 1e-9 with tight tolerances.
+set(screens two-screens --set mesh.blocks.0.cells=[16,8,8] --set time.endTime=0.06 ${tight})
+run(screens1 1 ${screens})
+run(screens2 2 ${screens})
+same(screens1 screens2 1e-9 membrane.screenA.maxDisplacement membrane.screenB.maxDisplacement fluid.max_velocity)
+file(READ ${WORK}/screens2/summary.json js)
+string(JSON a GET "${js}" metrics coupling.membrane.screenA.solved_on_rank)
+string(JSON b GET "${js}" metrics coupling.membrane.screenB.solved_on_rank)
+string(JSON n GET "${js}" metrics coupling.membranes_solved_on_rank0)
+if(a EQUAL b OR a LESS 0 OR b LESS 0 OR NOT n EQUAL 1)
+  message(SEND_ERROR "two screens on 2 ranks: solved on ranks ${a} and ${b}, ${n} on rank 0 (want one each)")
+endif()
 
 # Checkpoints every 3 steps, the last 2 kept: steps 6 and 9 on both ranks, step 3 gone from both.
 run(saved 2 ${cavity} --set output.checkpoint.everySteps=3)

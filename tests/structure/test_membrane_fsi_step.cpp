@@ -155,3 +155,47 @@ TEST(MembraneStepLineSearch, DomeSnapsThroughUnderPressureOnItsConvexSide) {
     }
   }
 }
+
+// A membrane solved on another rank (MembraneSolver::stepResult / adoptStep): a solver that did
+// not run the solves but receives each one's four Views holds the solving one's state bit for bit,
+// through relaxed trial displacements and commits over several steps, and its next own solve
+// gives the same answer. A mirror that received nothing is wrong (the check can fail).
+TEST(MembraneAdoptStep, AMirrorThatReceivesEachAnswerHoldsTheSolversState) {
+  const double dt = 0.01;
+  Square sq = square();
+  MembraneSolver owner(sq.mesh, sq.opt, sq.bc, sq.loads), mirror(sq.mesh, sq.opt, sq.bc, sq.loads),
+      unfed(sq.mesh, sq.opt, sq.bc, sq.loads);
+  RealView relaxed("relaxed", 3 * sq.mesh.nNodes());
+  for (int step = 0; step < 3; ++step) {
+    for (int iteration = 0; iteration < 2; ++iteration) {
+      const MembraneSolveReport rep = owner.solveStep(dt);
+      ASSERT_TRUE(rep.converged);
+      const auto from = owner.stepResult(), to = mirror.stepResult();
+      for (std::size_t k = 0; k < from.size(); ++k) Kokkos::deep_copy(to[k], from[k]);
+      mirror.adoptStep(dt, rep, owner.volumeConstraint().lambda);
+      EXPECT_EQ(mirror.lastReport().iterations, rep.iterations);
+      // The coupling relaxes the answer (here: 0.7 of it) and sets it on both.
+      Kokkos::deep_copy(relaxed, owner.trialDisplacement());
+      auto h = Kokkos::create_mirror_view_and_copy(HostSpace(), relaxed);
+      for (std::size_t i = 0; i < h.extent(0); ++i) h(i) *= 0.7 + 0.1 * iteration;
+      Kokkos::deep_copy(relaxed, h);
+      owner.setTrialDisplacement(relaxed);
+      mirror.setTrialDisplacement(relaxed);
+      EXPECT_EQ(host(mirror.trialVelocity()), host(owner.trialVelocity()));
+      EXPECT_EQ(host(mirror.trialAcceleration()), host(owner.trialAcceleration()));
+    }
+    owner.commitStep();
+    mirror.commitStep();
+    EXPECT_EQ(mirror.time(), owner.time());
+    EXPECT_EQ(host(mirror.displacement()), host(owner.displacement()));
+    EXPECT_EQ(host(mirror.velocity()), host(owner.velocity()));
+    EXPECT_EQ(host(mirror.acceleration()), host(owner.acceleration()));
+  }
+  // Its own solve from the adopted state: the owner's answer.
+  ASSERT_TRUE(owner.solveStep(dt).converged);
+  ASSERT_TRUE(mirror.solveStep(dt).converged);
+  EXPECT_EQ(host(mirror.trialDisplacement()), host(owner.trialDisplacement()));
+  // A solver that received nothing is not there.
+  EXPECT_GT(maxDifference(host(unfed.displacement()), host(owner.displacement())),
+            0.1 * maxAbs(host(owner.displacement())));
+}
