@@ -12,15 +12,19 @@ SolverComm::SolverComm(MPI_Comm comm, const Halo* halo) : comm_(comm), halo_(hal
 
 namespace {
 std::int64_t gReductions = 0;
+double gReductionSeconds = 0;
 }  // namespace
 
 std::int64_t SolverComm::reductions() { return gReductions; }
+double SolverComm::reductionSeconds() { return gReductionSeconds; }
 
 void SolverComm::gatherSum(double* values, int n) const {
   ++gReductions;
   // Every rank's partials, added in rank order: the same bits on every rank, every run.
   std::vector<double> all(static_cast<std::size_t>(n) * size_);
+  const double t0 = MPI_Wtime();
   MPI_Allgather(values, n, MPI_DOUBLE, all.data(), n, MPI_DOUBLE, comm_);
+  gReductionSeconds += MPI_Wtime() - t0;
   for (int i = 0; i < n; ++i) {
     double s = 0;
     for (int r = 0; r < size_; ++r) s += all[static_cast<std::size_t>(r) * n + i];
@@ -31,7 +35,9 @@ void SolverComm::gatherSum(double* values, int n) const {
 double SolverComm::reduceMax(double local) const {
   ++gReductions;
   double global = local;
+  const double t0 = MPI_Wtime();
   MPI_Allreduce(&local, &global, 1, MPI_DOUBLE, MPI_MAX, comm_);
+  gReductionSeconds += MPI_Wtime() - t0;
   return global;
 }
 

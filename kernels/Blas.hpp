@@ -51,6 +51,9 @@ class SolverComm {
   /// \brief Collective reductions (sums and maxima over more than one rank) this process has
   /// made so far, over every SolverComm: the latency count of the scaling model (perf/).
   static std::int64_t reductions();
+  /// \brief Wall seconds spent in those reductions (the messages and any wait for a rank still
+  /// computing).
+  static double reductionSeconds();
   /// \brief Maximum of a per-rank value over all ranks.
   double globalMax(double local) const { return size_ > 1 ? reduceMax(local) : local; }
   /// \brief Refresh ghost entries [nRows, nCols) of `x` before it is multiplied by a matrix.

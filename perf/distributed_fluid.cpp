@@ -89,6 +89,7 @@ int main(int argc, char** argv) {
     const long long haloBytes0 = Halo::allBytesSent(), haloMessages0 = Halo::allMessagesSent(),
                     exchanges0 = Halo::allExchanges(), reductions0 = SolverComm::reductions(),
                     gathers0 = DistributedAmg::coarseGathers();
+    const double transfer0 = Halo::allTransferSeconds(), reduction0 = SolverComm::reductionSeconds();
     Kokkos::fence();
     MPI_Barrier(MPI_COMM_WORLD);
     const double t0 = MPI_Wtime();
@@ -114,6 +115,10 @@ int main(int argc, char** argv) {
     long long allBytes = 0, allMessages = 0;
     MPI_Reduce(&bytes, &allBytes, 1, MPI_LONG_LONG, MPI_SUM, 0, MPI_COMM_WORLD);
     MPI_Reduce(&messages, &allMessages, 1, MPI_LONG_LONG, MPI_SUM, 0, MPI_COMM_WORLD);
+    // Seconds in halo transfers and in reductions, the largest over the ranks.
+    double waits[2] = {Halo::allTransferSeconds() - transfer0, SolverComm::reductionSeconds() - reduction0};
+    double maxWaits[2] = {0, 0};
+    MPI_Reduce(waits, maxWaits, 2, MPI_DOUBLE, MPI_MAX, 0, MPI_COMM_WORLD);
     int okInt = ok ? 1 : 0, allOk = 0;
     MPI_Allreduce(&okInt, &allOk, 1, MPI_INT, MPI_MIN, MPI_COMM_WORLD);
     const double cells = static_cast<double>(global.nCells());
@@ -121,12 +126,14 @@ int main(int argc, char** argv) {
       std::printf("n=%d^3 cells=%.0f mode=%s ranks=%d threads=%d edgecut=%lld steps=%d | %.4e s/cell-step, "
                   "%.3f s/step | pressure its/step %.2f, momentum its/step %.2f | cell halo per step (all ranks): "
                   "%.0f messages, %.0f bytes | all halos per step (all ranks): %.0f messages, %.0f bytes; per rank "
-                  "%.1f exchanges, %.1f reductions, %.1f coarse gathers | ok=%d\n",
+                  "%.1f exchanges, %.1f reductions, %.1f coarse gathers | halo transfers %.1f %%, reductions %.1f %% "
+                  "of the step (the largest rank's) | ok=%d\n",
                   n, cells, serial ? "serial" : "distributed", ranks, Kokkos::DefaultExecutionSpace().concurrency(),
                   static_cast<long long>(part.edgeCut), timed, wall / (timed * cells), wall / timed,
                   double(pIts) / timed, double(uIts) / timed, double(allMessages) / timed, double(allBytes) / timed,
                   double(allTotals[1]) / timed, double(allTotals[0]) / timed, double(exchanges) / timed,
-                  double(reductions) / timed, double(gathers) / timed, allOk);
+                  double(reductions) / timed, double(gathers) / timed, 100 * maxWaits[0] / wall,
+                  100 * maxWaits[1] / wall, allOk);
     }
     status = allOk ? 0 : 1;
   }

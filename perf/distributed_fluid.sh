@@ -44,9 +44,11 @@ for line in open(sys.argv[1]):
                  r"pressure its/step ([0-9.]+).*cell halo per step \(all ranks\): ([0-9.]+) messages, ([0-9.]+) bytes", line)
     if not m: continue
     n, mode, r, t, cut, s, pits, msg, byt = m.groups()
-    rows.setdefault((int(n), mode, int(r), int(t)), []).append((float(s), float(pits), int(cut), float(msg), float(byt)))
-print("\n| n³ | solver | ranks × threads | s/cell-step (median) | runs | pressure its/step | edge cut | cell-halo messages / MB per step | efficiency vs one-rank solver, same cores | vs decomposed on 1 rank × 1 thread |")
-print("|---|---|---|---|---|---|---|---|---|---|")
+    w = re.search(r"halo transfers ([0-9.]+) %, reductions ([0-9.]+) %", line)
+    waits = (float(w.group(1)), float(w.group(2))) if w else (float("nan"), float("nan"))
+    rows.setdefault((int(n), mode, int(r), int(t)), []).append((float(s), float(pits), int(cut), float(msg), float(byt), *waits))
+print("\n| n³ | solver | ranks × threads | s/cell-step (median) | runs | pressure its/step | edge cut | cell-halo messages / MB per step | halo transfers / reductions, % of the step (median) | efficiency vs one-rank solver, same cores | vs decomposed on 1 rank × 1 thread |")
+print("|---|---|---|---|---|---|---|---|---|---|---|")
 for key in sorted(rows, key=lambda k: (k[0], k[1] != "serial", k[2], k[3])):
     n, mode, r, t = key
     v = rows[key]
@@ -55,6 +57,7 @@ for key in sorted(rows, key=lambda k: (k[0], k[1] != "serial", k[2], k[3])):
     cores = r * t
     e1 = statistics.median(x[0] for x in base) / (s * cores) if base else float("nan")
     e2 = statistics.median(x[0] for x in dist1) / (s * cores) if dist1 else float("nan")
-    print(f"| {n} | {mode} | {r} × {t} | {s:.3e} | {len(v)} | {v[0][1]:.2f} | {v[0][2]} | {v[0][3]:.0f} / {v[0][4]/1e6:.2f} | {100*e1:.0f} % | {100*e2:.0f} % |")
+    hw = statistics.median(x[5] for x in v); rw = statistics.median(x[6] for x in v)
+    print(f"| {n} | {mode} | {r} × {t} | {s:.3e} | {len(v)} | {v[0][1]:.2f} | {v[0][2]} | {v[0][3]:.0f} / {v[0][4]/1e6:.2f} | {hw:.1f} / {rw:.1f} | {100*e1:.0f} % | {100*e2:.0f} % |")
 PY
 mv "$raw" "$out"

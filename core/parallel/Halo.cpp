@@ -7,6 +7,7 @@ namespace mfsi {
 namespace {
 constexpr int kHaloTag = 7411;
 std::int64_t gBytes = 0, gMessages = 0, gExchanges = 0;
+double gWaitSeconds = 0;
 static_assert(sizeof(real) == sizeof(double), "the halo sends reals as MPI_DOUBLE");
 }  // namespace
 
@@ -46,6 +47,7 @@ Halo::~Halo() {
 std::int64_t Halo::allBytesSent() { return gBytes; }
 std::int64_t Halo::allMessagesSent() { return gMessages; }
 std::int64_t Halo::allExchanges() { return gExchanges; }
+double Halo::allTransferSeconds() { return gWaitSeconds; }
 
 std::int64_t Halo::sendBytes(int components) const {
   return static_cast<std::int64_t>(sendOffsets_.empty() ? 0 : sendOffsets_.back()) * components *
@@ -93,8 +95,10 @@ void Halo::finish(int components) const {
 void Halo::transfer(const ExecSpace& exec, int components) const {
   Kokkos::deep_copy(exec, sendHost_, sendBuf_);
   exec.fence();
+  const double t0 = MPI_Wtime();
   start(components);
   finish(components);
+  gWaitSeconds += MPI_Wtime() - t0;
   bytesSent_ += sendBytes(components);
   messagesSent_ += sendMessages();
   gBytes += sendBytes(components);

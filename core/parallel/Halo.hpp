@@ -65,6 +65,10 @@ class Halo {
   static std::int64_t allBytesSent();
   static std::int64_t allMessagesSent();
   static std::int64_t allExchanges();
+  /// \brief Wall seconds this process has spent from starting its halos' messages to their
+  /// completion (the transfer itself and any wait for a neighbour still computing): what
+  /// overlapping an exchange with interior work could at most hide.
+  static double allTransferSeconds();
 
  private:
   void start(int components) const;

@@ -8,8 +8,9 @@
 /// face's values (pressure, vector area, area, centroid, and the tractions when asked) into the
 /// face's slot and the others write zeros, and one sum over the ranks completes every slot. Each
 /// sum adds one value to zeros, so every rank gets the owner's values bit for bit: the membrane's
-/// loads do not depend on the rank count, and every rank solves the same (small) membrane to the
-/// same answer without exchanging its displacements. On one rank the sum is a copy.
+/// loads do not depend on the rank count. The rank that owns all of a membrane's faces
+/// (`ownerRank`) solves it and sends its answer to the others (FsiCoupling). On one rank the sum
+/// is a copy.
 ///
 /// Slots: front faces (the patch, or a baffle's master side) in [0, n), a baffle's slave faces in
 /// [n, 2n). `gatheredInterface()` indexes them (front(e) = e, back(e) = n + e, no internal
