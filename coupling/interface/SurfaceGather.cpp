@@ -83,11 +83,10 @@ SurfaceGather::SurfaceGather(const HexMesh& whole, const HexMesh& part, MPI_Comm
   // rank), if one does.
   long long mine = 0;
   for (int o : owners) mine += o;
-  owner_ = mine == static_cast<long long>(owners.size()) ? 0 : -1;
+  int rank = 0;
+  if (comm_ != MPI_COMM_NULL) MPI_Comm_rank(comm_, &rank);
+  owner_ = mine == static_cast<long long>(owners.size()) ? rank : -1;
   if (comm_ != MPI_COMM_NULL) {
-    int rank = 0;
-    MPI_Comm_rank(comm_, &rank);
-    owner_ = mine == static_cast<long long>(owners.size()) ? rank : -1;
     MPI_Allreduce(MPI_IN_PLACE, &owner_, 1, MPI_INT, MPI_MAX, comm_);
     MPI_Allreduce(MPI_IN_PLACE, owners.data(), static_cast<int>(owners.size()), MPI_INT, MPI_SUM, comm_);
   }

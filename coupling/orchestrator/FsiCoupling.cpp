@@ -49,6 +49,7 @@ FsiCoupling::FsiCoupling(const CouplingOptions& options, const SceneConfig& sect
       ownedMembranes_(std::move(membranes)),
       rigid_(std::move(rigid)) {
   MFSI_CHECK(fluid_, "coupling: no fluid module");
+  if (comm_ != MPI_COMM_NULL) MPI_Comm_rank(comm_, &rank_);
   fluid_->solver().keepStepStart(options_.fluidFromStepStart);
   if (ownedMembranes_.empty() && options_.bodyPatches.empty())
     throw InputError(section.where(), "the coupling needs at least one membrane cut from the fluid mesh "
@@ -643,10 +644,8 @@ void FsiCoupling::solveStructure(double t1, double dt) {
   updateFrameInertia();  // the bodies' accelerations of this solve
   // On several ranks each membrane is solved by the rank that owns its faces, the ranks' membranes
   // at the same time; then every owner sends its answer to the others.
-  int rank = 0;
-  if (comm_ != MPI_COMM_NULL) MPI_Comm_rank(comm_, &rank);
   for (Panel& p : panels_) {
-    if (p.owner >= 0 && p.owner != rank) continue;
+    if (p.owner >= 0 && p.owner != rank_) continue;
     MembraneSolver& s = p.module->solver();
     p.report = p.dynamic ? s.solveStep(dt) : s.solveStatic(t1);
   }
@@ -669,9 +668,7 @@ void FsiCoupling::solveStructure(double t1, double dt) {
 void FsiCoupling::shareSolve(Panel& p, double t1, double dt) {
   ScopedTimer timer(timers_, "coupling.structureShare");
   MembraneSolver& s = p.module->solver();
-  int rank = 0;
-  MPI_Comm_rank(comm_, &rank);
-  const bool mine = rank == p.owner;
+  const bool mine = rank_ == p.owner;
   // The answer's Views (a step's trial state and the committed acceleration; a static solve's
   // displacement), then the report and the multiplier, in one message.
   std::vector<RealView> views;

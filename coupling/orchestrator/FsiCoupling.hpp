@@ -206,6 +206,7 @@ class FsiCoupling final : public Module {
   HexMesh& mesh_;
   const HexMesh& whole_;  ///< the whole mesh (mesh_ itself on one rank)
   MPI_Comm comm_ = MPI_COMM_NULL;  ///< several ranks: the ranks
+  int rank_ = 0;                    ///< this rank in comm_ (0 on one rank)
   Timers& timers_;
   ExecSpace exec_;
   std::unique_ptr<FluidModule> fluid_;
