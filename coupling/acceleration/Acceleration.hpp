@@ -44,6 +44,7 @@ enum class IqnJacobian {
   /// IQN-IMVJ (Lindner, Mehl & Uekermann 2015): the last step's whole inverse Jacobian J_prev,
   /// updated by this step's history, J = J_prev + (W - J_prev V) V^+: what past steps learnt is
   /// kept beyond the reused columns, and the step's first pass is already a quasi-Newton step.
+  /// Kept in low-rank form (at most iqnJacobianRank columns), never as an n x n matrix.
   MultiVector,
 };
 
@@ -66,6 +67,9 @@ struct AccelerationOptions {
   /// need not fall monotonically (an unstable 12-unknown affine map stalls 5 passes on its way to
   /// the exact answer at pass 13), hence a generous default.
   int stallIterations = 10;
+  /// IQN-IMVJ: the most columns of the low-rank part of the carried inverse Jacobian. Past it the
+  /// part is compressed by a truncated SVD to its largest half.
+  int iqnJacobianRank = 400;
 };
 
 /// \brief What one `update` did (steps.csv reports it).

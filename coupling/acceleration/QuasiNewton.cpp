@@ -127,6 +127,13 @@ InterfaceVector QuasiNewton::scaled(const InterfaceVector& a) const {
   return s;
 }
 
+Eigen::VectorXd QuasiNewton::scaling() const {
+  Eigen::VectorXd s(size_);
+  for (std::size_t b = 0; b < layout_.size(); ++b)
+    s.segment(layout_[b].offset, layout_[b].size).setConstant(blockWeight_[static_cast<Eigen::Index>(b)]);
+  return s;
+}
+
 void QuasiNewton::record(const InterfaceVector& xt, const InterfaceVector& r) {
   if (!havePrevious_) setScaling(r);
   if (havePrevious_) {
@@ -341,16 +348,15 @@ void IqnIls::step(const InterfaceVector& xt, const InterfaceVector& r, Interface
 
 IqnImvj::IqnImvj(const AccelerationOptions& options, std::vector<InterfaceBlock> layout, const SolverComm& comm)
     : QuasiNewton(options, std::move(layout), comm) {
-  if (size_ > kMaxUnknowns)
-    throw InputError("coupling.iqnJacobian: multiVector keeps a dense inverse Jacobian; this interface has " +
-                     std::to_string(size_) + " unknowns (at most " + std::to_string(kMaxUnknowns) +
-                     "): use leastSquares");
   if (comm_.ranks() > 1)
-    throw InputError("coupling.iqnJacobian: multiVector runs on one rank (its dense Jacobian is not distributed)");
+    throw InputError("coupling.iqnJacobian: multiVector runs on one rank (its compression is not distributed)");
+  MFSI_CHECK(options_.iqnJacobianRank >= 2, "coupling.iqnJacobianRank must be >= 2");
   // Where the history has seen nothing, the step is a relaxation by omegaInit: x~ - (1 - omega) r =
   // x + omega r. (With J = 0 there it would be the plain fixed-point step, which a strong added
   // mass makes unstable: the tube takes 6.5 instead of 5.5-5.9 iterations per step.)
-  jPrev_ = static_cast<float>(1 - options_.omegaInit) * Eigen::MatrixXf::Identity(size_, size_);
+  diagonal_ = 1 - options_.omegaInit;
+  left_.resize(size_, 0);
+  right_.resize(size_, 0);
 }
 
 void IqnImvj::beginStep() {
@@ -358,10 +364,22 @@ void IqnImvj::beginStep() {
   haveJr_ = false;
 }
 
+InterfaceVector IqnImvj::apply(const InterfaceVector& a) const {
+  InterfaceVector ja = diagonal_ * a;
+  if (left_.cols() > 0) ja.noalias() += left_ * (right_.transpose() * a);
+  return ja;
+}
+
+Eigen::MatrixXd IqnImvj::jacobian() const {
+  Eigen::MatrixXd j = left_ * right_.transpose();
+  j.diagonal().array() += diagonal_;
+  return j;
+}
+
 void IqnImvj::step(const InterfaceVector& xt, const InterfaceVector& r, InterfaceVector& x,
                    AccelerationReport& report) {
   record(xt, r);
-  const InterfaceVector jr = (jPrev_ * r.cast<float>()).cast<double>();
+  const InterfaceVector jr = apply(r);
   if (!columns_.empty() && columns_.front().jv.size() == 0) {  // the column record() just made
     // record() pairs a pass only with an earlier pass of the same step, whose J r is kept.
     MFSI_ASSERT(haveJr_, "IQN-IMVJ: a new column without the previous pass's J r");
@@ -392,7 +410,7 @@ void IqnImvj::endStep() {
   if (k == 0) return;
   // J += Z V^+ with Z = W - J V (n x k) and V^+ = R^-1 Q^T S (k x n). The columns of earlier steps
   // have J v = w from the last update, so only this step's columns (a zero column of Z elsewhere)
-  // enter the product.
+  // enter: they join the low-rank part as columns of L (Z) and of R (rows of V^+).
   Eigen::MatrixXd QtS(k, size_);
   for (Eigen::Index j = 0; j < k; ++j)
     QtS.row(j) = scaled(f.q[static_cast<std::size_t>(j)]).transpose();  // (S q)^T = q^T S, S diagonal
@@ -402,27 +420,79 @@ void IqnImvj::endStep() {
     const Column& c = columns_[static_cast<std::size_t>(j)];
     if (c.jv != c.w) fresh.push_back(j);
   }
-  const auto m = static_cast<Eigen::Index>(fresh.size());
-  Eigen::MatrixXf Z(size_, m), P(m, size_);
-  for (Eigen::Index i = 0; i < m; ++i) {
-    const Column& c = columns_[static_cast<std::size_t>(fresh[static_cast<std::size_t>(i)])];
-    Z.col(i) = (c.w - c.jv).cast<float>();
-    P.row(i) = pinv.row(fresh[static_cast<std::size_t>(i)]).cast<float>();
+  const auto m0 = left_.cols(), m = static_cast<Eigen::Index>(fresh.size());
+  if (m > 0) {
+    left_.conservativeResize(Eigen::NoChange, m0 + m);
+    right_.conservativeResize(Eigen::NoChange, m0 + m);
+    for (Eigen::Index i = 0; i < m; ++i) {
+      const Eigen::Index j = fresh[static_cast<std::size_t>(i)];
+      const Column& c = columns_[static_cast<std::size_t>(j)];
+      left_.col(m0 + i) = c.w - c.jv;
+      right_.col(m0 + i) = pinv.row(j).transpose();
+    }
   }
-  if (m > 0) jPrev_.noalias() += Z * P;
   for (Column& c : columns_) c.jv = c.w;
+  if (left_.cols() > options_.iqnJacobianRank) {
+    compress();
+    // The truncated J_prev no longer maps every kept column exactly: the next update restores J v = w.
+    for (Column& c : columns_) c.jv = apply(c.v);
+  }
+}
+
+void IqnImvj::compress() {
+  // S L R^T S^-1 = (S L)(S^-1 R)^T = Qa Ra Rb^T Qb^T, and the SVD of the small Ra Rb^T = U s V^T
+  // gives the best low-rank approximation: L = S^-1 Qa U s, R = S Qb V on the kept directions.
+  const Eigen::VectorXd s = scaling();
+  const Eigen::Index n = size_, m = left_.cols();
+  const Eigen::MatrixXd a = s.asDiagonal() * left_;
+  const Eigen::MatrixXd b = s.cwiseInverse().asDiagonal() * right_;
+  const Eigen::HouseholderQR<Eigen::MatrixXd> qa(a), qb(b);
+  const Eigen::Index ka = std::min(n, m);
+  const Eigen::MatrixXd ra = qa.matrixQR().topRows(ka).triangularView<Eigen::Upper>();
+  const Eigen::MatrixXd rb = qb.matrixQR().topRows(ka).triangularView<Eigen::Upper>();
+  const Eigen::BDCSVD<Eigen::MatrixXd> svd(ra * rb.transpose(), Eigen::ComputeThinU | Eigen::ComputeThinV);
+  const Eigen::VectorXd& sigma = svd.singularValues();
+  Eigen::Index keep = 0;
+  const Eigen::Index most = options_.iqnJacobianRank / 2;
+  while (keep < most && keep < sigma.size() && sigma[keep] > 1e-12 * sigma[0]) ++keep;
+  // The Householder reflectors applied to the kept directions alone (n x keep, not n x m).
+  Eigen::MatrixXd ua = Eigen::MatrixXd::Zero(n, keep), ub = Eigen::MatrixXd::Zero(n, keep);
+  ua.topRows(ka) = svd.matrixU().leftCols(keep) * sigma.head(keep).asDiagonal();
+  ub.topRows(ka) = svd.matrixV().leftCols(keep);
+  ua.applyOnTheLeft(qa.householderQ());
+  ub.applyOnTheLeft(qb.householderQ());
+  left_ = s.cwiseInverse().asDiagonal() * ua;
+  right_ = s.asDiagonal() * ub;
+  ++compressions_;
 }
 
 void IqnImvj::saveState(io::StateWriter& w) const {
   QuasiNewton::saveState(w);
-  w.put("inverseJacobian", std::vector<double>(jPrev_.data(), jPrev_.data() + jPrev_.size()));  // floats, exactly
+  w.putInt("jacobianRank", left_.cols());
+  w.putInt("jacobianCompressions", compressions_);
+  w.put("jacobianLeft", std::vector<double>(left_.data(), left_.data() + left_.size()));
+  w.put("jacobianRight", std::vector<double>(right_.data(), right_.data() + right_.size()));
+  std::vector<double> jv;
+  for (const Column& c : columns_) jv.insert(jv.end(), c.jv.data(), c.jv.data() + c.jv.size());
+  w.put("JV", jv);
 }
 
 void IqnImvj::loadState(const io::StateReader& r) {
   QuasiNewton::loadState(r);
-  const auto j = r.doubles("inverseJacobian", static_cast<long long>(size_) * size_);
-  jPrev_ = Eigen::Map<const Eigen::MatrixXd>(j.data(), size_, size_).cast<float>();
-  for (Column& c : columns_) c.jv = c.w;  // as endStep left them
+  if (r.has("inverseJacobian") && !r.has("jacobianRank"))
+    throw InputError(r.where("inverseJacobian") +
+                     ": a dense IQN-IMVJ Jacobian, written by an earlier mfsi; this one keeps it in low-rank form "
+                     "(restart from a checkpoint of this version, or start the run again)");
+  const auto m = static_cast<Eigen::Index>(r.integer("jacobianRank"));
+  if (m < 0) throw InputError(r.where("jacobianRank") + ": negative");
+  compressions_ = static_cast<int>(r.integer("jacobianCompressions"));
+  const auto l = r.doubles("jacobianLeft", static_cast<long long>(size_) * m);
+  const auto rr = r.doubles("jacobianRight", static_cast<long long>(size_) * m);
+  left_ = Eigen::Map<const Eigen::MatrixXd>(l.data(), size_, m);
+  right_ = Eigen::Map<const Eigen::MatrixXd>(rr.data(), size_, m);
+  const auto jv = r.doubles("JV", static_cast<long long>(columns_.size()) * size_);
+  for (std::size_t i = 0; i < columns_.size(); ++i)
+    columns_[i].jv = Eigen::Map<const InterfaceVector>(jv.data() + i * static_cast<std::size_t>(size_), size_);
   haveJr_ = false;
 }
 

@@ -58,6 +58,8 @@ class QuasiNewton : public Acceleration {
   const Factorisation& factorisation() const { return qr_; }
   /// S a: the block scaling of this step.
   InterfaceVector scaled(const InterfaceVector& a) const;
+  /// The diagonal of S, one weight per unknown.
+  Eigen::VectorXd scaling() const;
   /// A relaxation step x <- x + omega r (Aitken's omega, or omegaInit without history).
   void relax(const InterfaceVector& r, InterfaceVector& x, AccelerationReport& report);
   /// IQN-ILS's alpha = argmin |S (V alpha + r)| on the current factorisation.
@@ -102,28 +104,42 @@ class IqnIls final : public QuasiNewton {
 /// steps, J_prev <- J_prev + (W - J_prev V) V^+ at each step's end (V^+ = R^-1 Q^T S: J V = W on
 /// every kept column, reused ones included). J_prev starts as (1 - omegaInit) I, a relaxation by
 /// omegaInit in every direction no history has seen, so the first pass of the first step is the
-/// relaxation step of IQN-ILS. J_prev is a dense n x n matrix on one rank: for interfaces of up to
-/// kMaxUnknowns unknowns.
+/// relaxation step of IQN-ILS.
+///
+/// J_prev is never an n x n matrix: it is (1 - omegaInit) I + L R^T with L and R of n x m, each
+/// step's update appending its columns (W - J_prev V and the rows of V^+), so a pass costs O(n m)
+/// and any interface size works. Past iqnJacobianRank columns the low-rank part is compressed: a
+/// truncated SVD of S L R^T S^-1 (the step's block scaling, so membrane displacements and body DOFs
+/// weigh alike) keeps its largest half, and drops directions below 1e-12 of the largest. Until the
+/// first compression J_prev is the dense update's exactly (to round-off).
 class IqnImvj final : public QuasiNewton {
  public:
-  static constexpr Eigen::Index kMaxUnknowns = 20000;
-  /// Throws InputError past kMaxUnknowns or on more than one rank.
+  /// Throws InputError on more than one rank (the compression is not distributed).
   IqnImvj(const AccelerationOptions& options, std::vector<InterfaceBlock> layout, const SolverComm& comm);
   void beginStep() override;
   void endStep() override;
   void saveState(io::StateWriter& w) const override;
   void loadState(const io::StateReader& r) override;
-  /// The inverse Jacobian carried between steps. For tests.
-  const Eigen::MatrixXf& jacobian() const { return jPrev_; }
+  /// The inverse Jacobian carried between steps, as a dense matrix. For tests (small n).
+  Eigen::MatrixXd jacobian() const;
+  /// Columns of its low-rank part now.
+  Eigen::Index rank() const { return left_.cols(); }
+  /// How often the low-rank part has been compressed.
+  int compressions() const { return compressions_; }
 
  protected:
   void step(const InterfaceVector& xt, const InterfaceVector& r, InterfaceVector& x,
             AccelerationReport& report) override;
 
  private:
-  /// Single precision: the matrix-vector product of every pass reads n^2 values (memory-bound), and
-  /// the Jacobian is a model; the fixed point is judged on the residual, in double.
-  Eigen::MatrixXf jPrev_;
+  /// J_prev a.
+  InterfaceVector apply(const InterfaceVector& a) const;
+  /// The truncated SVD of the low-rank part (iqnJacobianRank / 2 columns at most).
+  void compress();
+
+  double diagonal_ = 1;        ///< J_prev = diagonal_ I + left_ right_^T
+  Eigen::MatrixXd left_, right_;  ///< n x m each
+  int compressions_ = 0;
   /// J_prev r of the step's previous pass: a new column's J_prev v is the difference of two of
   /// them, so no pass multiplies J_prev by the history. After each step's update J_prev v = w holds
   /// on every kept column, which is what carries them to the next step without a product either.

@@ -97,9 +97,14 @@ Schema couplingSchema() {
       .key("iqnJacobian",
            Schema::choice("the inverse Jacobian of the quasi-Newton method: leastSquares (IQN-ILS, from the history "
                           "alone) or multiVector (IQN-IMVJ: the previous steps' Jacobian updated by this step's "
-                          "history; dense, one rank)",
+                          "history, kept in low-rank form; one rank)",
                           {"leastSquares", "multiVector"}),
            Default("leastSquares"))
+      .key("iqnJacobianRank",
+           Schema::integer("multiVector: the most columns of the carried inverse Jacobian's low-rank part (past it a "
+                           "truncated SVD keeps its largest half)")
+               .atLeast(2),
+           Default(a.iqnJacobianRank))
       .key("iqnFilter",
            Schema::real("QR2 filter: drop a column whose new part is below this fraction of its norm", "-")
                .atLeast(0)
@@ -221,6 +226,7 @@ CouplingOptions readCouplingOptions(const SceneConfig& c) {
   a.iqnJacobian = c.get<std::string>("iqnJacobian") == "multiVector" ? coupling::IqnJacobian::MultiVector
                                                                       : coupling::IqnJacobian::LeastSquares;
 
+  a.iqnJacobianRank = c.get<int>("iqnJacobianRank");
   a.iqnFilterEps = c.get<double>("iqnFilter");
   a.maxUpdate = c.get<double>("iqnMaxUpdate");
   a.stallIterations = c.get<int>("stallIterations");
