@@ -3,6 +3,8 @@
 #include "core/Error.hpp"
 #include "core/parallel/Halo.hpp"
 #include "core/parallel/RowExchange.hpp"
+#include "kernels/Blas.hpp"
+#include "kernels/CsrBuild.hpp"
 
 #include <Eigen/Dense>
 
@@ -36,7 +38,9 @@ Kokkos::View<T*, MemSpace> deviceCopy(const std::vector<T>& v, const std::string
   return d;
 }
 
-CsrMatrix toDevice(const HostCsr& h, const std::string& label) {
+/// The matrix on the device; with `rowRuns`, its row runs too (kernels/CsrMatrix: host backends
+/// then sweep runs of rows with one column pattern; the same bits as the row kernels).
+CsrMatrix toDevice(const HostCsr& h, const std::string& label, bool rowRuns = false) {
   CsrMatrix M;
   M.nRows = h.nRows;
   M.nCols = h.nCols;
@@ -48,6 +52,7 @@ CsrMatrix toDevice(const HostCsr& h, const std::string& label) {
     for (lid_t p = h.ptr[i]; p < h.ptr[i + 1]; ++p)
       if (h.col[p] == i) diag[i] = p;
   M.diagIdx = deviceCopy(diag, label + "::diagIdx");
+  if (rowRuns && kHostExec) M.runs = buildRowRuns(h.nRows, h.ptr, h.col, label);
   return M;
 }
 
@@ -128,6 +133,18 @@ void chebyshevDirection(const ExecSpace& exec, lid_t n, double a, double c, cons
       KOKKOS_LAMBDA(lid_t i) { d(i) = a * d(i) + c * inv(i) * r(i); });
 }
 
+/// r = b and d = c inv .* b on the first n entries: the residual and first Chebyshev direction of a
+/// smoothing that starts from x = 0 (what b - A 0 and c inv .* r give, bit for bit, without the product).
+void fromZero(const ExecSpace& exec, lid_t n, double c, const RealView& inv, const RealView& b, const RealView& r,
+              const RealView& d) {
+  Kokkos::parallel_for(
+      "mfsi::kernels::damg::fromZero", RangePolicy(exec, 0, n), KOKKOS_LAMBDA(lid_t i) {
+        const double bi = b(i);
+        r(i) = bi;
+        d(i) = c * inv(i) * bi;
+      });
+}
+
 /// r = b - r on the first n entries.
 void fromProduct(const ExecSpace& exec, lid_t n, const RealView& b, const RealView& r) {
   Kokkos::parallel_for(
@@ -186,7 +203,7 @@ struct DistributedAmg::Impl {
 
   void finishLevel(const ExecSpace& exec, Level& L, std::size_t l) {
     const std::string label = "mfsi::kernels::damg::level" + std::to_string(l);
-    L.A = toDevice(L.hA, label + "::A");
+    L.A = toDevice(L.hA, label + "::A", true);
     L.halo = std::make_unique<Halo>(comm, L.plan);
     L.invDiag = RealView(label + "::invDiag", L.hA.nRows);
     invertDiagonal(exec, L.A, L.invDiag);
@@ -478,13 +495,18 @@ struct DistributedAmg::Impl {
 
   /// Fourth-kind Chebyshev smoothing in D^-1 A on [0, lambda_max] (Lottes 2023, as kernels/Amg):
   /// d_0 = 4 / (3 rho) D^-1 r_0, d_k = (2k - 1) / (2k + 3) d_{k-1} + (8k + 4) / ((2k + 3) rho) D^-1 r_k.
-  void chebyshev(const ExecSpace& exec, Level& L) {
+  /// `fromZeroX`: x is 0 (the pre-smoothing of a V-cycle), so r_0 = b needs no product.
+  void chebyshev(const ExecSpace& exec, Level& L, bool fromZeroX) {
     const lid_t n = L.hA.nRows;
     const double rho = L.lambdaMax;
-    L.halo->exchange(exec, L.x);
-    blas::spmv(exec, L.A, L.x, L.r);
-    fromProduct(exec, n, L.b, L.r);
-    scaled(exec, n, 4.0 / (3.0 * rho), L.invDiag, L.r, L.d);
+    if (fromZeroX) {
+      fromZero(exec, n, 4.0 / (3.0 * rho), L.invDiag, L.b, L.r, L.d);
+    } else {
+      L.halo->exchange(exec, L.x);
+      blas::spmv(exec, L.A, L.x, L.r);
+      fromProduct(exec, n, L.b, L.r);
+      scaled(exec, n, 4.0 / (3.0 * rho), L.invDiag, L.r, L.d);
+    }
     for (int k = 1; k <= opt.chebyshevDegree; ++k) {
       blas::axpy(exec, n, 1.0, L.d, L.x);
       if (k == opt.chebyshevDegree) break;
@@ -503,7 +525,7 @@ struct DistributedAmg::Impl {
     }
     const lid_t n = L.hA.nRows;
     blas::fill(exec, L.hA.nCols, 0.0, L.x);
-    chebyshev(exec, L);
+    chebyshev(exec, L, true);
     L.halo->exchange(exec, L.x);
     blas::spmv(exec, L.A, L.x, L.r);
     fromProduct(exec, n, L.b, L.r);
@@ -513,7 +535,7 @@ struct DistributedAmg::Impl {
     cycle(exec, l + 1);
     C.halo->exchange(exec, C.x);
     blas::spmv(exec, 1.0, L.P, C.x, 1.0, L.x);
-    chebyshev(exec, L);
+    chebyshev(exec, L, false);
   }
 };
 
