@@ -9,7 +9,9 @@
 #include <Eigen/Dense>
 
 #include <algorithm>
+#include <array>
 #include <cmath>
+#include <cstdlib>
 #include <limits>
 #include <map>
 #include <memory>
@@ -119,6 +121,101 @@ std::vector<lid_t> aggregateOwned(const HostCsr& A, double theta, lid_t& nAgg) {
   return agg;
 }
 
+/// A structured lattice's extents (x fastest), and every owned row's cell on it.
+struct LatticeRows {
+  std::array<std::int64_t, 3> extent{0, 0, 0};
+  std::vector<std::array<std::int64_t, 3>> at;  ///< owned rows; empty: not a lattice
+  bool valid() const { return extent[0] > 0; }
+};
+
+/// The lattice of the fine level, or none. The candidate extents come from the smallest global-id
+/// steps between coupled rows over all ranks (nx: the smallest above 1; nx ny: the next); then
+/// every rank checks that each owned row holds its diagonal and exactly its in-range lattice
+/// neighbours (by global id), all strong, and all ranks must agree.
+LatticeRows detectLattice(MPI_Comm comm, const HostCsr& A, const std::vector<gid_t>& gid, std::int64_t rows,
+                          double theta) {
+  const lid_t n = A.nRows;
+  std::int64_t step[2] = {std::numeric_limits<std::int64_t>::max(), std::numeric_limits<std::int64_t>::max()};
+  for (int pass = 0; pass < 2; ++pass) {
+    const std::int64_t above = pass == 0 ? 1 : step[0];
+    std::int64_t best = std::numeric_limits<std::int64_t>::max();
+    for (lid_t i = 0; i < n; ++i)
+      for (lid_t p = A.ptr[i]; p < A.ptr[i + 1]; ++p) {
+        const std::int64_t d = std::llabs(gid[A.col[p]] - gid[i]);
+        if (d > above) best = std::min(best, d);
+      }
+    if (comm != MPI_COMM_NULL) MPI_Allreduce(MPI_IN_PLACE, &best, 1, MPI_INT64_T, MPI_MIN, comm);
+    step[pass] = best;
+    if (best == std::numeric_limits<std::int64_t>::max()) break;
+  }
+  LatticeRows L;
+  const std::int64_t none = std::numeric_limits<std::int64_t>::max();
+  if (step[0] == none) return L;  // no coupling beyond +-1: a line, left to greedy aggregation
+  const std::int64_t nx = step[0], nxy = step[1] == none ? rows : step[1];
+  if (nxy % nx != 0 || rows % nxy != 0) return L;
+  const std::array<std::int64_t, 3> e{nx, nxy / nx, rows / nxy};
+  std::vector<double> d(n, 0.0);
+  int ok = 1;
+  std::vector<std::array<std::int64_t, 3>> at(n);
+  for (lid_t i = 0; i < n && ok; ++i) {
+    const gid_t g = gid[i];
+    at[i] = {g % e[0], (g / e[0]) % e[1], g / nxy};
+    for (lid_t p = A.ptr[i]; p < A.ptr[i + 1]; ++p)
+      if (A.col[p] == i) d[i] = A.val[p];
+    ok = g >= 0 && g < rows && d[i] != 0;
+  }
+  for (lid_t i = 0; i < n && ok; ++i) {
+    const std::int64_t stride[3] = {1, e[0], nxy};
+    int expected = 1;
+    for (int k = 0; k < 3; ++k) expected += (at[i][k] > 0) + (at[i][k] + 1 < e[k]);
+    if (A.ptr[i + 1] - A.ptr[i] != expected) ok = 0;
+    for (lid_t p = A.ptr[i]; p < A.ptr[i + 1] && ok; ++p) {
+      const lid_t j = A.col[p];
+      if (j == i) continue;
+      const std::int64_t delta = gid[j] - gid[i];
+      bool neighbour = false;
+      for (int k = 0; k < 3; ++k)
+        neighbour = neighbour || (delta == stride[k] && at[i][k] + 1 < e[k]) || (delta == -stride[k] && at[i][k] > 0);
+      // A ghost's diagonal is not here: its coupling is checked against this row's diagonal, and
+      // its owner checks it against the ghost's (together stricter than the product, A symmetric).
+      const double dj = j < n ? d[j] : d[i];
+      ok = neighbour && std::abs(A.val[p]) >= theta * std::sqrt(std::abs(d[i] * dj));
+    }
+  }
+  if (comm != MPI_COMM_NULL) MPI_Allreduce(MPI_IN_PLACE, &ok, 1, MPI_INT, MPI_MIN, comm);
+  if (!ok) return L;
+  L.extent = e;
+  L.at = std::move(at);
+  return L;
+}
+
+/// Lattice-aligned aggregation of the owned rows: the rows in one cube of `factor` cells per
+/// direction (1 in a direction of extent 1) form one aggregate, numbered in the cubes' lexicographic
+/// order (x fastest); the coarse lattice (cube extents and positions) is returned in `coarse`.
+std::vector<lid_t> aggregateLattice(const LatticeRows& fine, std::int64_t factor, lid_t& nAgg, LatticeRows& coarse) {
+  std::array<std::int64_t, 3> f{}, ce{};
+  for (int k = 0; k < 3; ++k) {
+    f[k] = fine.extent[k] > 1 ? factor : 1;
+    ce[k] = (fine.extent[k] + f[k] - 1) / f[k];
+  }
+  const std::size_t n = fine.at.size();
+  std::vector<std::int64_t> key(n);
+  for (std::size_t i = 0; i < n; ++i)
+    key[i] = fine.at[i][0] / f[0] + ce[0] * (fine.at[i][1] / f[1] + ce[1] * (fine.at[i][2] / f[2]));
+  std::vector<std::int64_t> cubes = key;
+  std::sort(cubes.begin(), cubes.end());
+  cubes.erase(std::unique(cubes.begin(), cubes.end()), cubes.end());
+  std::vector<lid_t> agg(n);
+  for (std::size_t i = 0; i < n; ++i)
+    agg[i] = static_cast<lid_t>(std::lower_bound(cubes.begin(), cubes.end(), key[i]) - cubes.begin());
+  nAgg = static_cast<lid_t>(cubes.size());
+  coarse.extent = ce;
+  coarse.at.resize(cubes.size());
+  for (std::size_t a = 0; a < cubes.size(); ++a)
+    coarse.at[a] = {cubes[a] % ce[0], (cubes[a] / ce[0]) % ce[1], cubes[a] / (ce[0] * ce[1])};
+  return agg;
+}
+
 /// d = c * inv .* r on the first n entries.
 void scaled(const ExecSpace& exec, lid_t n, double c, const RealView& inv, const RealView& r, const RealView& d) {
   Kokkos::parallel_for(
@@ -177,6 +274,7 @@ struct DistributedAmg::Impl {
     CsrMatrix A, P, R;
     RealView invDiag, x, b, r, d;
     double lambdaMax = 1;
+    LatticeRows lattice;  ///< this level's lattice (owned rows), when it is aggregated into cubes
   };
 
   MPI_Comm comm = MPI_COMM_NULL;  ///< null on one rank
@@ -240,7 +338,11 @@ struct DistributedAmg::Impl {
     Level& L = levels[l];
     const lid_t nOwned = L.hA.nRows, nLocal = L.hA.nCols;
     lid_t nAgg = 0;
-    const std::vector<lid_t> agg = aggregateOwned(L.hA, l == 0 ? opt.strengthThreshold : 0.0, nAgg);
+    LatticeRows coarseLattice;
+    const std::vector<lid_t> agg = L.lattice.valid()
+                                       ? aggregateLattice(L.lattice, l == 0 ? 2 : 3, nAgg, coarseLattice)
+                                       : aggregateOwned(L.hA, l == 0 ? opt.strengthThreshold : 0.0, nAgg);
+    info[l].lattice = L.lattice.valid();
     const std::int64_t rows = info[l].rows, coarseRows = globalCount(nAgg);
     if (coarseRows >= rows) return false;  // no coarsening: solve this level directly
 
@@ -369,6 +471,7 @@ struct DistributedAmg::Impl {
     for (lid_t a = 0; a < nAgg; ++a) C.gid[a] = first + a;
     for (std::size_t g = 0; g < ghosts.size(); ++g) C.gid[nAgg + g] = ghosts[g];
     C.plan = planFromGhosts(comm, first, nAgg, ghosts, owner);
+    C.lattice = std::move(coarseLattice);
     levels.push_back(std::move(C));
     finishLevel(exec, levels.back(), l + 1);
     return true;
@@ -573,6 +676,10 @@ void DistributedAmg::setup(const ExecSpace& exec, const CsrMatrix& A) {
   L0.plan = m.finePlan;
   m.levels.push_back(std::move(L0));
   m.finishLevel(exec, m.levels.back(), 0);
+  if (m.opt.latticeAggregation) {
+    Impl::Level& F = m.levels.front();
+    F.lattice = detectLattice(m.comm, F.hA, F.gid, m.info.front().rows, m.opt.strengthThreshold);
+  }
   while (static_cast<int>(m.levels.size()) < m.opt.maxLevels && m.info.back().rows > m.opt.coarseSize)
     if (!m.coarsen(exec, m.levels.size() - 1)) break;
   // One rank inverts its coarsest level densely; several gather it onto every rank.

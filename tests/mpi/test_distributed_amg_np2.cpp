@@ -3,9 +3,18 @@
 #include "support/DistributedAmgChecks.hpp"
 #include "support/LocalParts.hpp"
 
+#include <algorithm>
+#include <random>
+
 using namespace mfsi;
 
 namespace {
+int worldRank() {
+  int r = 0;
+  MPI_Comm_rank(MPI_COMM_WORLD, &r);
+  return r;
+}
+
 HexMeshInput box(std::array<int, 3> n) {
   BlockMeshSpec spec = boxSpec({0, 0, 0}, {1, 1, 1}, n);
   spec.blocks[0].patches[0] = "xmin";
@@ -34,4 +43,50 @@ TEST(DistributedAmg, ALargeGatheredCoarseLevelIsSolvedByItsOwnAmg) {
   PartitionOptions opt;
   opt.parts = 2;
   test::checkGatheredCoarseAmg(in, partitionCells(in, opt).cellRank);
+}
+
+TEST(DistributedAmg, LatticeCubesPerRankKeepTheOneProcessIterations) {
+  // A box numbered x fastest is a lattice: 2x2x2 cubes, then 3x3x3, each cut where METIS cuts.
+  // Greedy aggregates on the same parts need more iterations (at 64^3 on 2 ranks: 13 against 9).
+  const HexMeshInput in = box({32, 32, 32});
+  PartitionOptions opt;
+  opt.parts = 2;
+  const std::vector<int> parts = partitionCells(in, opt).cellRank;
+  const auto [one, lattice] = test::checkDistributedAmg(in, parts);
+  EXPECT_LE(lattice, one + 1);
+  DistributedAmgOptions greedy;
+  greedy.latticeAggregation = false;
+  const auto [one2, many] = test::checkDistributedAmg(in, parts, greedy);
+  EXPECT_EQ(one2, one);
+  EXPECT_GE(many, lattice + 2);
+  // The hierarchy: the finest level and the next aggregated into cubes; about 32^3 / 8 (plus the
+  // cubes the cut splits) rows on level 1.
+  const HexMesh global = buildHexMesh(in);
+  const LocalMeshPart part = localMeshPart(global, parts, 2, worldRank());
+  const HexMesh local = buildHexMesh(part.input);
+  const Halo halo(MPI_COMM_WORLD, part.cells);
+  const test::AmgSolve s = test::solveWithAmg(MPI_COMM_WORLD, local, part.cells, &halo);
+  ASSERT_GE(s.levels.size(), 3u);
+  EXPECT_TRUE(s.levels[0].lattice);
+  EXPECT_TRUE(s.levels[1].lattice);
+  EXPECT_GE(s.levels[1].rows, 4096);
+  EXPECT_LE(s.levels[1].rows, 4096 + 600);
+}
+
+TEST(DistributedAmg, CellsOutOfLatticeOrderAreAggregatedGreedily) {
+  // The same box with its cells in a shuffled order: no longer a lattice by its ids.
+  HexMeshInput in = box({12, 12, 12});
+  std::mt19937 rng(7);
+  std::shuffle(in.cells.begin(), in.cells.end(), rng);
+  const HexMesh global = buildHexMesh(in);
+  PartitionOptions opt;
+  opt.parts = 2;
+  const std::vector<int> parts = partitionCells(in, opt).cellRank;
+  test::checkDistributedAmg(in, parts);
+  const LocalMeshPart part = localMeshPart(global, parts, 2, worldRank());
+  const HexMesh local = buildHexMesh(part.input);
+  const Halo halo(MPI_COMM_WORLD, part.cells);
+  const test::AmgSolve s = test::solveWithAmg(MPI_COMM_WORLD, local, part.cells, &halo);
+  EXPECT_TRUE(s.solve.converged);
+  EXPECT_FALSE(s.levels[0].lattice);
 }
