@@ -180,31 +180,38 @@ Kokkos::RangePolicy<HostExecSpace> hostPolicy(const E& exec, lid_t begin, lid_t 
     return Kokkos::RangePolicy<HostExecSpace>(begin, end);
 }
 
-/// Host pointers to a matrix's runs and values.
-struct RunView {
+/// Host pointers to a matrix's runs and values (V: the values' type; a float copy of a matrix's
+/// values shares its sparsity and runs).
+template <class V>
+struct RunViewOf {
   const lid_t* start = nullptr;
   const lid_t* offsetsAt = nullptr;
   const lid_t* offsets = nullptr;
   const lid_t* rowPtr = nullptr;
-  const double* val = nullptr;
+  const V* val = nullptr;
+  RunViewOf() = default;
+  RunViewOf(const CsrRowRuns& runs, const IndexView& ptr, const V* values)
+      : start(runs.start.data()),
+        offsetsAt(runs.offsetsAt.data()),
+        offsets(runs.offsets.data()),
+        rowPtr(ptr.data()),
+        val(values) {}
+};
+
+struct RunView : RunViewOf<double> {
   RunView() = default;
-  explicit RunView(const CsrMatrix& A)
-      : start(A.runs.start.data()),
-        offsetsAt(A.runs.offsetsAt.data()),
-        offsets(A.runs.offsets.data()),
-        rowPtr(A.rowPtr.data()),
-        val(A.values.data()) {}
+  explicit RunView(const CsrMatrix& A) : RunViewOf<double>(A.runs, A.rowPtr, A.values.data()) {}
 };
 
 /// Calls row(i, v, off, w) for every row i of run r: v points at row i's w values, whose columns
 /// are i + off[k]. w is std::integral_constant<int, 7> for 7-entry rows (the interior of a hex
 /// block; the loop over k unrolls) and an int otherwise.
-template <class Row>
-inline void forRunRows(const RunView& R, lid_t r, const Row& row) {
+template <class V, class Row>
+inline void forRunRows(const RunViewOf<V>& R, lid_t r, const Row& row) {
   const lid_t i0 = R.start[r], i1 = R.start[r + 1];
   const lid_t w = R.rowPtr[i0 + 1] - R.rowPtr[i0];
   const lid_t* off = R.offsets + R.offsetsAt[r];
-  const double* v = R.val + R.rowPtr[i0] - static_cast<std::ptrdiff_t>(i0) * w;
+  const V* v = R.val + R.rowPtr[i0] - static_cast<std::ptrdiff_t>(i0) * w;
   if (w == 7) {
     MFSI_IVDEP
     for (lid_t i = i0; i < i1; ++i)
@@ -215,9 +222,9 @@ inline void forRunRows(const RunView& R, lid_t r, const Row& row) {
 }
 
 /// sum_k v[k] x[i + off[k]]: one row of A x inside forRunRows, in the row kernels' order.
-template <class Width>
-inline double runRowDot(const double* v, const double* x, lid_t i, const lid_t* off, Width width) {
-  double s = 0.0;
+template <class S, class Width>
+inline S runRowDot(const S* v, const S* x, lid_t i, const lid_t* off, Width width) {
+  S s = 0;
   for (int k = 0; k < width; ++k) s += v[k] * x[i + off[k]];
   return s;
 }

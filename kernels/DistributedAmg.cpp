@@ -16,6 +16,7 @@
 #include <map>
 #include <memory>
 #include <string>
+#include <type_traits>
 
 namespace mfsi {
 
@@ -42,7 +43,9 @@ Kokkos::View<T*, MemSpace> deviceCopy(const std::vector<T>& v, const std::string
 
 /// The matrix on the device; with `rowRuns`, its row runs too (kernels/CsrMatrix: host backends
 /// then sweep runs of rows with one column pattern; the same bits as the row kernels).
-CsrMatrix toDevice(const HostCsr& h, const std::string& label, bool rowRuns = false) {
+/// `sameSparsity`: a matrix of h's sparsity whose runs (if it has any) are taken instead of built.
+CsrMatrix toDevice(const HostCsr& h, const std::string& label, bool rowRuns = false,
+                   const CsrMatrix* sameSparsity = nullptr) {
   CsrMatrix M;
   M.nRows = h.nRows;
   M.nCols = h.nCols;
@@ -54,7 +57,8 @@ CsrMatrix toDevice(const HostCsr& h, const std::string& label, bool rowRuns = fa
     for (lid_t p = h.ptr[i]; p < h.ptr[i + 1]; ++p)
       if (h.col[p] == i) diag[i] = p;
   M.diagIdx = deviceCopy(diag, label + "::diagIdx");
-  if (rowRuns && kHostExec) M.runs = buildRowRuns(h.nRows, h.ptr, h.col, label);
+  if (rowRuns && kHostExec)
+    M.runs = sameSparsity && sameSparsity->runs.count > 0 ? sameSparsity->runs : buildRowRuns(h.nRows, h.ptr, h.col, label);
   return M;
 }
 
@@ -216,15 +220,77 @@ std::vector<lid_t> aggregateLattice(const LatticeRows& fine, std::int64_t factor
   return agg;
 }
 
+template <class S>
+using SView = Kokkos::View<S*, MemSpace>;
+
+/// A level operator in the cycle's precision S: a matrix's sparsity (and row runs) with its
+/// values (S = double: the matrix's own; float: a rounded copy).
+template <class S>
+struct CycleMat {
+  lid_t nRows = 0;
+  IndexView rowPtr, colIdx;
+  SView<S> val;
+  CsrRowRuns runs;
+};
+
+template <class S>
+CycleMat<S> cycleMat(const ExecSpace& exec, const CsrMatrix& M) {
+  CycleMat<S> C;
+  C.nRows = M.nRows;
+  C.rowPtr = M.rowPtr;
+  C.colIdx = M.colIdx;
+  C.runs = M.runs;
+  if constexpr (std::is_same<S, double>::value) {
+    C.val = M.values;
+  } else {
+    C.val = SView<S>(Kokkos::view_alloc(Kokkos::WithoutInitializing, M.values.label() + "::float"), M.values.extent(0));
+    const SView<S> v = C.val;
+    const RealView m = M.values;
+    Kokkos::parallel_for(
+        "mfsi::kernels::damg::round", RangePolicy(exec, 0, static_cast<lid_t>(v.extent(0))),
+        KOKKOS_LAMBDA(lid_t k) { v(k) = static_cast<S>(m(k)); });
+  }
+  return C;
+}
+
+/// y = alpha M x + beta y (beta = 0: y not read), row by row; host backends sweep M's row runs.
+template <class S>
+void spmv(const ExecSpace& exec, S alpha, const CycleMat<S>& M, const SView<S>& x, S beta, const SView<S>& y) {
+  if (kHostExec && M.runs.count > 0) {
+    const blas::detail::RunViewOf<S> R(M.runs, M.rowPtr, M.val.data());
+    const S* xp = x.data();
+    S* yp = y.data();
+    exec.fence();
+    Kokkos::parallel_for("mfsi::kernels::damg::spmv", blas::detail::hostPolicy(exec, 0, M.runs.count), [=](lid_t r) {
+      blas::detail::forRunRows(R, r, [&](lid_t i, const S* v, const lid_t* off, auto width) {
+        const S t = blas::detail::runRowDot(v, xp, i, off, width);
+        yp[i] = beta == 0 ? alpha * t : alpha * t + beta * yp[i];
+      });
+    });
+    HostExecSpace().fence();
+    return;
+  }
+  const IndexView rowPtr = M.rowPtr, colIdx = M.colIdx;
+  const SView<S> val = M.val;
+  Kokkos::parallel_for(
+      "mfsi::kernels::damg::spmv", RangePolicy(exec, 0, M.nRows), KOKKOS_LAMBDA(lid_t i) {
+        S t = 0;
+        for (lid_t k = rowPtr(i); k < rowPtr(i + 1); ++k) t += val(k) * x(colIdx(k));
+        y(i) = beta == 0 ? alpha * t : alpha * t + beta * y(i);
+      });
+}
+
 /// d = c * inv .* r on the first n entries.
-void scaled(const ExecSpace& exec, lid_t n, double c, const RealView& inv, const RealView& r, const RealView& d) {
+template <class S>
+void scaled(const ExecSpace& exec, lid_t n, S c, const SView<S>& inv, const SView<S>& r, const SView<S>& d) {
   Kokkos::parallel_for(
       "mfsi::kernels::damg::scaled", RangePolicy(exec, 0, n), KOKKOS_LAMBDA(lid_t i) { d(i) = c * inv(i) * r(i); });
 }
 
 /// d = a d + c inv .* r on the first n entries.
-void chebyshevDirection(const ExecSpace& exec, lid_t n, double a, double c, const RealView& inv, const RealView& r,
-                        const RealView& d) {
+template <class S>
+void chebyshevDirection(const ExecSpace& exec, lid_t n, S a, S c, const SView<S>& inv, const SView<S>& r,
+                        const SView<S>& d) {
   Kokkos::parallel_for(
       "mfsi::kernels::damg::direction", RangePolicy(exec, 0, n),
       KOKKOS_LAMBDA(lid_t i) { d(i) = a * d(i) + c * inv(i) * r(i); });
@@ -232,20 +298,37 @@ void chebyshevDirection(const ExecSpace& exec, lid_t n, double a, double c, cons
 
 /// r = b and d = c inv .* b on the first n entries: the residual and first Chebyshev direction of a
 /// smoothing that starts from x = 0 (what b - A 0 and c inv .* r give, bit for bit, without the product).
-void fromZero(const ExecSpace& exec, lid_t n, double c, const RealView& inv, const RealView& b, const RealView& r,
-              const RealView& d) {
+template <class S>
+void fromZero(const ExecSpace& exec, lid_t n, S c, const SView<S>& inv, const SView<S>& b, const SView<S>& r,
+              const SView<S>& d) {
   Kokkos::parallel_for(
       "mfsi::kernels::damg::fromZero", RangePolicy(exec, 0, n), KOKKOS_LAMBDA(lid_t i) {
-        const double bi = b(i);
+        const S bi = b(i);
         r(i) = bi;
         d(i) = c * inv(i) * bi;
       });
 }
 
 /// r = b - r on the first n entries.
-void fromProduct(const ExecSpace& exec, lid_t n, const RealView& b, const RealView& r) {
+template <class S>
+void fromProduct(const ExecSpace& exec, lid_t n, const SView<S>& b, const SView<S>& r) {
   Kokkos::parallel_for(
       "mfsi::kernels::damg::residual", RangePolicy(exec, 0, n), KOKKOS_LAMBDA(lid_t i) { r(i) = b(i) - r(i); });
+}
+
+/// x += d on the first n entries.
+template <class S>
+void addTo(const ExecSpace& exec, lid_t n, const SView<S>& d, const SView<S>& x) {
+  Kokkos::parallel_for(
+      "mfsi::kernels::damg::add", RangePolicy(exec, 0, n), KOKKOS_LAMBDA(lid_t i) { x(i) += d(i); });
+}
+
+/// dst = src on the first n entries, converted to dst's precision.
+template <class D, class Src>
+void convert(const ExecSpace& exec, lid_t n, const Src& src, const SView<D>& dst) {
+  Kokkos::parallel_for(
+      "mfsi::kernels::damg::convert", RangePolicy(exec, 0, n),
+      KOKKOS_LAMBDA(lid_t i) { dst(i) = static_cast<D>(src(i)); });
 }
 
 /// x(i) = sum_k inv(i, k) b(k): the gathered coarsest solve of the owned rows, in a fixed order.
@@ -276,6 +359,12 @@ struct DistributedAmg::Impl {
     double lambdaMax = 1;
     LatticeRows lattice;  ///< this level's lattice (owned rows), when it is aggregated into cubes
   };
+  /// A level in the cycle's precision S (S = double: the level's own matrices and vectors).
+  template <class S>
+  struct CycleLevel {
+    CycleMat<S> A, P, R;
+    SView<S> invDiag, x, b, r, d;
+  };
 
   MPI_Comm comm = MPI_COMM_NULL;  ///< null on one rank
   int ranks = 1, me = 0;
@@ -283,6 +372,8 @@ struct DistributedAmg::Impl {
   HaloPlan finePlan;
   std::vector<gid_t> fineIds;
   std::vector<Level> levels;
+  std::vector<CycleLevel<double>> cycleDouble;  ///< the cycle's levels (one of the two, by opt.mixedPrecision)
+  std::vector<CycleLevel<float>> cycleFloat;
   std::vector<DistributedAmgLevelInfo> info;
   // Coarsest level, gathered on every rank.
   Kokkos::View<double**, MemSpace> coarseInv;  ///< owned rows x all rows (gathered order)
@@ -299,9 +390,10 @@ struct DistributedAmg::Impl {
     return g;
   }
 
-  void finishLevel(const ExecSpace& exec, Level& L, std::size_t l) {
+  /// `given`: the matrix level 0 was copied from (its row runs are reused).
+  void finishLevel(const ExecSpace& exec, Level& L, std::size_t l, const CsrMatrix* given = nullptr) {
     const std::string label = "mfsi::kernels::damg::level" + std::to_string(l);
-    L.A = toDevice(L.hA, label + "::A", true);
+    L.A = toDevice(L.hA, label + "::A", true, given);
     L.halo = std::make_unique<Halo>(comm, L.plan);
     L.invDiag = RealView(label + "::invDiag", L.hA.nRows);
     invertDiagonal(exec, L.A, L.invDiag);
@@ -596,49 +688,84 @@ struct DistributedAmg::Impl {
     }
   }
 
-  /// Fourth-kind Chebyshev smoothing in D^-1 A on [0, lambda_max] (Lottes 2023, as kernels/Amg):
-  /// d_0 = 4 / (3 rho) D^-1 r_0, d_k = (2k - 1) / (2k + 3) d_{k-1} + (8k + 4) / ((2k + 3) rho) D^-1 r_k.
-  /// `fromZeroX`: x is 0 (the pre-smoothing of a V-cycle), so r_0 = b needs no product.
-  void chebyshev(const ExecSpace& exec, Level& L, bool fromZeroX) {
-    const lid_t n = L.hA.nRows;
-    const double rho = L.lambdaMax;
-    if (fromZeroX) {
-      fromZero(exec, n, 4.0 / (3.0 * rho), L.invDiag, L.b, L.r, L.d);
-    } else {
-      L.halo->exchange(exec, L.x);
-      blas::spmv(exec, L.A, L.x, L.r);
-      fromProduct(exec, n, L.b, L.r);
-      scaled(exec, n, 4.0 / (3.0 * rho), L.invDiag, L.r, L.d);
-    }
-    for (int k = 1; k <= opt.chebyshevDegree; ++k) {
-      blas::axpy(exec, n, 1.0, L.d, L.x);
-      if (k == opt.chebyshevDegree) break;
-      L.halo->exchange(exec, L.d);
-      blas::spmv(exec, -1.0, L.A, L.d, 1.0, L.r);
-      chebyshevDirection(exec, n, (2.0 * k - 1.0) / (2.0 * k + 3.0), (8.0 * k + 4.0) / ((2.0 * k + 3.0) * rho),
-                         L.invDiag, L.r, L.d);
+  /// The cycle's levels in precision S: the operators (float: rounded copies sharing the
+  /// sparsity and row runs), inverse diagonals and work vectors.
+  template <class S>
+  void buildCycle(const ExecSpace& exec, std::vector<CycleLevel<S>>& cycle) {
+    cycle.clear();
+    for (std::size_t l = 0; l < levels.size(); ++l) {
+      Level& L = levels[l];
+      CycleLevel<S> C;
+      const std::string label = "mfsi::kernels::damg::level" + std::to_string(l);
+      if constexpr (std::is_same<S, double>::value) {
+        C.invDiag = L.invDiag;
+        C.x = L.x;
+        C.b = L.b;
+        C.r = L.r;
+        C.d = L.d;
+      } else {
+        C.invDiag = SView<S>(label + "::invDiag::float", L.hA.nRows);
+        convert<S>(exec, L.hA.nRows, L.invDiag, C.invDiag);
+        for (SView<S>* v : {&C.x, &C.b, &C.r, &C.d}) *v = SView<S>(label + "::work::float", L.hA.nCols);
+      }
+      C.A = cycleMat<S>(exec, L.A);
+      if (l + 1 < levels.size()) {
+        C.P = cycleMat<S>(exec, L.P);
+        C.R = cycleMat<S>(exec, L.R);
+      }
+      cycle.push_back(std::move(C));
     }
   }
 
-  void cycle(const ExecSpace& exec, std::size_t l) {
+  /// Fourth-kind Chebyshev smoothing in D^-1 A on [0, lambda_max] (Lottes 2023, as kernels/Amg):
+  /// d_0 = 4 / (3 rho) D^-1 r_0, d_k = (2k - 1) / (2k + 3) d_{k-1} + (8k + 4) / ((2k + 3) rho) D^-1 r_k.
+  /// `fromZeroX`: x is 0 (the pre-smoothing of a V-cycle), so r_0 = b needs no product.
+  template <class S>
+  void chebyshev(const ExecSpace& exec, const Level& L, CycleLevel<S>& C, bool fromZeroX) {
+    const lid_t n = L.hA.nRows;
+    const double rho = L.lambdaMax;
+    const S c0 = static_cast<S>(4.0 / (3.0 * rho));
+    if (fromZeroX) {
+      fromZero<S>(exec, n, c0, C.invDiag, C.b, C.r, C.d);
+    } else {
+      L.halo->exchange(exec, C.x);
+      spmv<S>(exec, 1, C.A, C.x, 0, C.r);
+      fromProduct<S>(exec, n, C.b, C.r);
+      scaled<S>(exec, n, c0, C.invDiag, C.r, C.d);
+    }
+    for (int k = 1; k <= opt.chebyshevDegree; ++k) {
+      addTo<S>(exec, n, C.d, C.x);
+      if (k == opt.chebyshevDegree) break;
+      L.halo->exchange(exec, C.d);
+      spmv<S>(exec, -1, C.A, C.d, 1, C.r);
+      chebyshevDirection<S>(exec, n, static_cast<S>((2.0 * k - 1.0) / (2.0 * k + 3.0)),
+                            static_cast<S>((8.0 * k + 4.0) / ((2.0 * k + 3.0) * rho)), C.invDiag, C.r, C.d);
+    }
+  }
+
+  template <class S>
+  void cycle(const ExecSpace& exec, std::vector<CycleLevel<S>>& cyc, std::size_t l) {
     Level& L = levels[l];
-    if (l + 1 == levels.size()) {
+    CycleLevel<S>& C = cyc[l];
+    const lid_t n = L.hA.nRows;
+    if (l + 1 == levels.size()) {  // the coarsest solve, in double
+      if constexpr (!std::is_same<S, double>::value) convert<double>(exec, n, C.b, L.b);
       coarseSolve(exec, L);
+      if constexpr (!std::is_same<S, double>::value) convert<S>(exec, n, L.x, C.x);
       return;
     }
-    const lid_t n = L.hA.nRows;
-    blas::fill(exec, L.hA.nCols, 0.0, L.x);
-    chebyshev(exec, L, true);
-    L.halo->exchange(exec, L.x);
-    blas::spmv(exec, L.A, L.x, L.r);
-    fromProduct(exec, n, L.b, L.r);
-    L.halo->exchange(exec, L.r);
-    Level& C = levels[l + 1];
-    blas::spmv(exec, L.R, L.r, C.b);
-    cycle(exec, l + 1);
-    C.halo->exchange(exec, C.x);
-    blas::spmv(exec, 1.0, L.P, C.x, 1.0, L.x);
-    chebyshev(exec, L, false);
+    Kokkos::deep_copy(exec, C.x, S(0));
+    chebyshev(exec, L, C, true);
+    L.halo->exchange(exec, C.x);
+    spmv<S>(exec, 1, C.A, C.x, 0, C.r);
+    fromProduct<S>(exec, n, C.b, C.r);
+    L.halo->exchange(exec, C.r);
+    CycleLevel<S>& N = cyc[l + 1];
+    spmv<S>(exec, 1, C.R, C.r, 0, N.b);
+    cycle(exec, cyc, l + 1);
+    levels[l + 1].halo->exchange(exec, N.x);
+    spmv<S>(exec, 1, C.P, N.x, 1, C.x);
+    chebyshev(exec, L, C, false);
   }
 };
 
@@ -675,7 +802,7 @@ void DistributedAmg::setup(const ExecSpace& exec, const CsrMatrix& A) {
   L0.gid = m.fineIds;
   L0.plan = m.finePlan;
   m.levels.push_back(std::move(L0));
-  m.finishLevel(exec, m.levels.back(), 0);
+  m.finishLevel(exec, m.levels.back(), 0, &A);
   if (m.opt.latticeAggregation) {
     Impl::Level& F = m.levels.front();
     F.lattice = detectLattice(m.comm, F.hA, F.gid, m.info.front().rows, m.opt.strengthThreshold);
@@ -687,16 +814,28 @@ void DistributedAmg::setup(const ExecSpace& exec, const CsrMatrix& A) {
              "distributed AMG: the coarsest level still has "
                                               << m.info.back().rows << " rows (raise maxLevels)");
   m.gatherCoarsest(exec);
+  m.cycleDouble.clear();
+  m.cycleFloat.clear();
+  if (m.opt.mixedPrecision)
+    m.buildCycle(exec, m.cycleFloat);
+  else
+    m.buildCycle(exec, m.cycleDouble);
 }
 
 void DistributedAmg::apply(const ExecSpace& exec, const ConstRealView& r, const RealView& z) {
   Impl& m = *impl_;
   MFSI_CHECK(!m.levels.empty(), "distributed AMG: apply before setup");
-  Impl::Level& L = m.levels.front();
-  const lid_t n = L.hA.nRows;
-  Kokkos::deep_copy(exec, Kokkos::subview(L.b, std::make_pair(0, n)), Kokkos::subview(r, std::make_pair(0, n)));
-  m.cycle(exec, 0);
-  Kokkos::deep_copy(exec, Kokkos::subview(z, std::make_pair(0, n)), Kokkos::subview(L.x, std::make_pair(0, n)));
+  const lid_t n = m.levels.front().hA.nRows;
+  if (m.opt.mixedPrecision) {
+    convert<float>(exec, n, r, m.cycleFloat.front().b);
+    m.cycle(exec, m.cycleFloat, 0);
+    convert<double>(exec, n, m.cycleFloat.front().x, z);
+  } else {
+    Impl::Level& L = m.levels.front();
+    Kokkos::deep_copy(exec, Kokkos::subview(L.b, std::make_pair(0, n)), Kokkos::subview(r, std::make_pair(0, n)));
+    m.cycle(exec, m.cycleDouble, 0);
+    Kokkos::deep_copy(exec, Kokkos::subview(z, std::make_pair(0, n)), Kokkos::subview(L.x, std::make_pair(0, n)));
+  }
 }
 
 }  // namespace mfsi

@@ -21,10 +21,11 @@
 ///    dense pseudo-inverse up to `denseCoarseRows` rows, above that by one V-cycle of a
 ///    one-process DistributedAmg of the gathered matrix;
 ///  - symmetric V-cycle with fourth-kind Chebyshev smoothing in D^{-1} A (lambda_max from power
-///    iterations, boosted by 1.1), every product after a halo exchange; every sum in a fixed order.
+///    iterations, boosted by 1.1), every product after a halo exchange; every sum in a fixed order;
+///    in float by default (`mixedPrecision`), set-up in double.
 /// One rank is the same algorithm with no communication (the reference the distributed
 /// iteration counts are compared with). The serial kernels/Amg.hpp remains the one-rank solver of
-/// the fluid (lattice-patterned storage, float cycle); this one is double throughout.
+/// the fluid (lattice-patterned storage); this one keeps CSR with row runs.
 /// Measured (perf/distributed_amg.sh, 64^3 Laplacian, CG to 1e-8, one rank): greedy aggregation
 /// 13 iterations (kernels/Amg with greedy aggregates: 13 too), lattice cubes 9 (kernels/Amg: 9).
 #include "core/parallel/LocalMesh.hpp"
@@ -51,6 +52,10 @@ struct DistributedAmgOptions {
   int maxLevels = 16;
   /// Lattice-aligned cubes where the fine matrix is a structured lattice (false: greedy always).
   bool latticeAggregation = true;
+  /// The V-cycle in float (rounded copies of every level's operator, P, R and inverse diagonal;
+  /// float vectors and halo exchanges; the coarsest solve in double), as kernels/Amg's Mixed: about
+  /// a third fewer bytes per cycle; set-up computes in double either way. false: double throughout.
+  bool mixedPrecision = true;
 };
 
 /// \brief One level: rows over all ranks, nonzeros over all ranks, and this rank's rows and ghosts.

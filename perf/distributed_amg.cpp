@@ -2,8 +2,9 @@
 // mpirun: iterations, set-up and solve times, the levels, halo traffic. perf/distributed_amg.sh
 // runs it on 1, 2 and 4 ranks and writes perf/results/distributed_amg.txt.
 //
-//   mpirun -np 4 build/perf/perf_distributed_amg 64 [neumann|dirichlet] [greedy]
-// ("greedy": greedy aggregation even where the box is a lattice, for comparison)
+//   mpirun -np 4 build/perf/perf_distributed_amg 64 [neumann|dirichlet] [greedy] [double]
+// (for comparison: "greedy" aggregates greedily even where the box is a lattice, "double" runs the
+// V-cycle in double instead of float)
 #include "core/BlockMesh.hpp"
 #include "core/parallel/Halo.hpp"
 #include "core/parallel/LocalMesh.hpp"
@@ -64,8 +65,13 @@ int main(int argc, char** argv) {
     MPI_Comm_size(MPI_COMM_WORLD, &ranks);
     MPI_Comm_rank(MPI_COMM_WORLD, &rank);
     const int n = argc > 1 ? std::atoi(argv[1]) : 32;
-    const bool neumann = argc > 2 && std::string(argv[2]) == "neumann";
-    const bool greedy = argc > 3 && std::string(argv[3]) == "greedy";
+    bool neumann = false, greedy = false, inDouble = false;
+    for (int a = 2; a < argc; ++a) {
+      const std::string w = argv[a];
+      neumann = neumann || w == "neumann";
+      greedy = greedy || w == "greedy";
+      inDouble = inDouble || w == "double";
+    }
     BlockMeshSpec spec = boxSpec({0, 0, 0}, {1, 1, 1}, {n, n, n});
     spec.blocks[0].patches[0] = "xmin";
     const HexMeshInput in = generateBlockMesh(spec);
@@ -90,6 +96,7 @@ int main(int argc, char** argv) {
     double t0 = MPI_Wtime();
     DistributedAmgOptions aopt;
     aopt.latticeAggregation = !greedy;
+    aopt.mixedPrecision = !inDouble;
     DistributedAmg amg(MPI_COMM_WORLD, lp.cells, std::vector<mfsi::gid_t>(gid.data(), gid.data() + gid.extent(0)),
                        aopt);
     amg.setup(exec, A);
@@ -111,9 +118,9 @@ int main(int argc, char** argv) {
     MPI_Reduce(&bytes, &allBytes, 1, MPI_LONG_LONG, MPI_SUM, 0, MPI_COMM_WORLD);
     MPI_Reduce(&messages, &allMessages, 1, MPI_INT, MPI_SUM, 0, MPI_COMM_WORLD);
     if (rank == 0) {
-      std::printf("n=%d^3 %s %s ranks=%d threads=%d edgecut=%lld | distributed AMG-CG to 1e-8: %d iterations (%s), "
+      std::printf("n=%d^3 %s %s %s ranks=%d threads=%d edgecut=%lld | distributed AMG-CG to 1e-8: %d iterations (%s), "
                   "set-up %.3f s, solve %.3f s (%.2f ms per iteration) | levels:",
-                  n, neumann ? "neumann" : "dirichlet", amg.levels().front().lattice ? "lattice" : "greedy", ranks, exec.concurrency(),
+                  n, neumann ? "neumann" : "dirichlet", amg.levels().front().lattice ? "lattice" : "greedy", inDouble ? "double" : "float", ranks, exec.concurrency(),
                   static_cast<long long>(part.edgeCut), r.iterations, toString(r.status), tSetup, tSolve,
                   1e3 * tSolve / std::max(1, r.iterations));
       for (const auto& l : amg.levels()) std::printf(" %lld", static_cast<long long>(l.rows));

@@ -110,6 +110,7 @@ void Halo::transfer(const ExecSpace& exec, int components) const {
 namespace {
 // Entry k of row i of a field with K columns, for the pack and unpack kernels.
 KOKKOS_INLINE_FUNCTION real& entry(const RealView& x, lid_t i, int) { return x(i); }
+KOKKOS_INLINE_FUNCTION float& entry(const Kokkos::View<float*, MemSpace>& x, lid_t i, int) { return x(i); }
 KOKKOS_INLINE_FUNCTION real& entry(const Real3View& x, lid_t i, int k) { return x(i, k); }
 KOKKOS_INLINE_FUNCTION real& entry(const Kokkos::View<real* [3][3], MemSpace>& x, lid_t i, int k) {
   return x(i, k / 3, k % 3);
@@ -137,6 +138,10 @@ void Halo::exchangeColumns(const ExecSpace& exec, const View& x) const {
 }
 
 void Halo::exchange(const ExecSpace& exec, const RealView& x) const { exchangeColumns<1>(exec, x); }
+
+void Halo::exchange(const ExecSpace& exec, const Kokkos::View<float*, MemSpace>& x) const {
+  exchangeColumns<1>(exec, x);
+}
 
 void Halo::exchange(const ExecSpace& exec, const Real3View& x) const { exchangeColumns<3>(exec, x); }
 

@@ -40,6 +40,8 @@ class Halo {
 
   /// \brief Ghost entries [nOwned, nLocal) of `x` <- their owners' values.
   void exchange(const ExecSpace& exec, const RealView& x) const;
+  /// \brief The same for a float field (sent as doubles: a float cycle's halo, kernels/DistributedAmg).
+  void exchange(const ExecSpace& exec, const Kokkos::View<float*, MemSpace>& x) const;
   /// \brief The same for the three columns of an n x 3 field, in one message per neighbour.
   void exchange(const ExecSpace& exec, const Real3View& x) const;
   /// \brief The same for the nine entries of an n x 3 x 3 field (a gradient of a vector).

@@ -90,3 +90,17 @@ TEST(DistributedAmg, CellsOutOfLatticeOrderAreAggregatedGreedily) {
   EXPECT_TRUE(s.solve.converged);
   EXPECT_FALSE(s.levels[0].lattice);
 }
+
+TEST(DistributedAmg, TheFloatCycleTakesTheIterationsOfTheDoubleOne) {
+  // The default V-cycle runs in float; rounding it must not cost CG iterations, and both reach the
+  // one-process answer (checked inside to 1e-9 relative).
+  const HexMeshInput in = box({24, 24, 24});
+  PartitionOptions opt;
+  opt.parts = 2;
+  const std::vector<int> parts = partitionCells(in, opt).cellRank;
+  DistributedAmgOptions inDouble;
+  inDouble.mixedPrecision = false;
+  const int withFloat = test::checkDistributedAmg(in, parts).second;
+  const int withDouble = test::checkDistributedAmg(in, parts, inDouble).second;
+  EXPECT_LE(std::abs(withFloat - withDouble), 1);
+}
