@@ -135,9 +135,10 @@ struct LatticeRows {
 /// The lattice of the fine level, or none. The candidate extents come from the smallest global-id
 /// steps between coupled rows over all ranks (nx: the smallest above 1; nx ny: the next); then
 /// every rank checks that each owned row holds its diagonal and exactly its in-range lattice
-/// neighbours (by global id), all strong, and all ranks must agree.
+/// neighbours (by global id), all strong (`diagonal`: of every local row and ghost), and all
+/// ranks must agree.
 LatticeRows detectLattice(MPI_Comm comm, const HostCsr& A, const std::vector<gid_t>& gid, std::int64_t rows,
-                          double theta) {
+                          double theta, const std::vector<double>& diagonal) {
   const lid_t n = A.nRows;
   std::int64_t step[2] = {std::numeric_limits<std::int64_t>::max(), std::numeric_limits<std::int64_t>::max()};
   for (int pass = 0; pass < 2; ++pass) {
@@ -158,14 +159,12 @@ LatticeRows detectLattice(MPI_Comm comm, const HostCsr& A, const std::vector<gid
   const std::int64_t nx = step[0], nxy = step[1] == none ? rows : step[1];
   if (nxy % nx != 0 || rows % nxy != 0) return L;
   const std::array<std::int64_t, 3> e{nx, nxy / nx, rows / nxy};
-  std::vector<double> d(n, 0.0);
+  const std::vector<double>& d = diagonal;
   int ok = 1;
   std::vector<std::array<std::int64_t, 3>> at(n);
   for (lid_t i = 0; i < n && ok; ++i) {
     const gid_t g = gid[i];
     at[i] = {g % e[0], (g / e[0]) % e[1], g / nxy};
-    for (lid_t p = A.ptr[i]; p < A.ptr[i + 1]; ++p)
-      if (A.col[p] == i) d[i] = A.val[p];
     ok = g >= 0 && g < rows && d[i] != 0;
   }
   for (lid_t i = 0; i < n && ok; ++i) {
@@ -180,10 +179,7 @@ LatticeRows detectLattice(MPI_Comm comm, const HostCsr& A, const std::vector<gid
       bool neighbour = false;
       for (int k = 0; k < 3; ++k)
         neighbour = neighbour || (delta == stride[k] && at[i][k] + 1 < e[k]) || (delta == -stride[k] && at[i][k] > 0);
-      // A ghost's diagonal is not here: its coupling is checked against this row's diagonal, and
-      // its owner checks it against the ghost's (together stricter than the product, A symmetric).
-      const double dj = j < n ? d[j] : d[i];
-      ok = neighbour && std::abs(A.val[p]) >= theta * std::sqrt(std::abs(d[i] * dj));
+      ok = neighbour && std::abs(A.val[p]) >= theta * std::sqrt(std::abs(d[i] * d[j]));
     }
   }
   if (comm != MPI_COMM_NULL) MPI_Allreduce(MPI_IN_PLACE, &ok, 1, MPI_INT, MPI_MIN, comm);
@@ -434,9 +430,9 @@ struct DistributedAmg::Impl {
     const std::vector<lid_t> agg = L.lattice.valid()
                                        ? aggregateLattice(L.lattice, l == 0 ? 2 : 3, nAgg, coarseLattice)
                                        : aggregateOwned(L.hA, l == 0 ? opt.strengthThreshold : 0.0, nAgg);
-    info[l].lattice = L.lattice.valid();
     const std::int64_t rows = info[l].rows, coarseRows = globalCount(nAgg);
     if (coarseRows >= rows) return false;  // no coarsening: solve this level directly
+    info[l].lattice = L.lattice.valid();
 
     // Global ids of the aggregates: contiguous per rank.
     std::vector<gid_t> start(ranks + 1, 0);
@@ -805,7 +801,18 @@ void DistributedAmg::setup(const ExecSpace& exec, const CsrMatrix& A) {
   m.finishLevel(exec, m.levels.back(), 0, &A);
   if (m.opt.latticeAggregation) {
     Impl::Level& F = m.levels.front();
-    F.lattice = detectLattice(m.comm, F.hA, F.gid, m.info.front().rows, m.opt.strengthThreshold);
+    // The diagonal of every owned row and ghost (the ghosts' from their owners).
+    auto hd = Kokkos::create_mirror_view(F.r);
+    for (lid_t i = 0; i < F.hA.nRows; ++i) {
+      hd(i) = 0.0;
+      for (lid_t p = F.hA.ptr[i]; p < F.hA.ptr[i + 1]; ++p)
+        if (F.hA.col[p] == i) hd(i) = F.hA.val[p];
+    }
+    Kokkos::deep_copy(F.r, hd);
+    F.halo->exchange(exec, F.r);
+    Kokkos::deep_copy(hd, F.r);
+    const std::vector<double> diagonal(hd.data(), hd.data() + F.hA.nCols);
+    F.lattice = detectLattice(m.comm, F.hA, F.gid, m.info.front().rows, m.opt.strengthThreshold, diagonal);
   }
   while (static_cast<int>(m.levels.size()) < m.opt.maxLevels && m.info.back().rows > m.opt.coarseSize)
     if (!m.coarsen(exec, m.levels.size() - 1)) break;
