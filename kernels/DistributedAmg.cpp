@@ -75,15 +75,21 @@ HostCsr hostCopy(const CsrMatrix& A) {
   return h;
 }
 
+/// The diagonal entry of every owned row (0 where a row has none).
+std::vector<double> diagonalOf(const HostCsr& A) {
+  std::vector<double> d(A.nRows, 0.0);
+  for (lid_t i = 0; i < A.nRows; ++i)
+    for (lid_t p = A.ptr[i]; p < A.ptr[i + 1]; ++p)
+      if (A.col[p] == i) d[i] = A.val[p];
+  return d;
+}
+
 /// Greedy three-phase aggregation of the owned rows over their owned strong couplings
 /// (|a_ij| >= theta sqrt(|a_ii a_jj|); theta = 0: every nonzero coupling). Every row gets an
 /// aggregate (an isolated row is one of its own).
 std::vector<lid_t> aggregateOwned(const HostCsr& A, double theta, lid_t& nAgg) {
   const lid_t n = A.nRows;
-  std::vector<double> d(n, 0.0);
-  for (lid_t i = 0; i < n; ++i)
-    for (lid_t p = A.ptr[i]; p < A.ptr[i + 1]; ++p)
-      if (A.col[p] == i) d[i] = A.val[p];
+  const std::vector<double> d = diagonalOf(A);
   auto strong = [&](lid_t i, lid_t p) {
     const lid_t j = A.col[p];
     if (j == i || j >= n || A.val[p] == 0) return false;
@@ -457,11 +463,10 @@ struct DistributedAmg::Impl {
     // ghosts' rows from their owners.
     const double omega = opt.prolongationDamping / L.lambdaMax;
     GlobalRows pOwned;
+    const std::vector<double> diag = diagonalOf(L.hA);
     for (lid_t i = 0; i < nOwned; ++i) {
       std::map<gid_t, double> row;
-      double di = 0;
-      for (lid_t p = L.hA.ptr[i]; p < L.hA.ptr[i + 1]; ++p)
-        if (L.hA.col[p] == i) di = L.hA.val[p];
+      const double di = diag[i];
       row[cg[i]] += 1.0;
       for (lid_t p = L.hA.ptr[i]; p < L.hA.ptr[i + 1]; ++p) row[cg[L.hA.col[p]]] -= omega * L.hA.val[p] / di;
       pOwned.push(Row(row.begin(), row.end()));
@@ -803,11 +808,8 @@ void DistributedAmg::setup(const ExecSpace& exec, const CsrMatrix& A) {
     Impl::Level& F = m.levels.front();
     // The diagonal of every owned row and ghost (the ghosts' from their owners).
     auto hd = Kokkos::create_mirror_view(F.r);
-    for (lid_t i = 0; i < F.hA.nRows; ++i) {
-      hd(i) = 0.0;
-      for (lid_t p = F.hA.ptr[i]; p < F.hA.ptr[i + 1]; ++p)
-        if (F.hA.col[p] == i) hd(i) = F.hA.val[p];
-    }
+    const std::vector<double> owned = diagonalOf(F.hA);
+    for (lid_t i = 0; i < F.hA.nRows; ++i) hd(i) = owned[i];
     Kokkos::deep_copy(F.r, hd);
     F.halo->exchange(exec, F.r);
     Kokkos::deep_copy(hd, F.r);
