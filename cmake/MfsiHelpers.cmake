@@ -8,15 +8,21 @@ function(mfsi_warnings target)
   endif()
 endfunction()
 
-# mfsi_library(NAME <layer> DEPS <targets...>)
+# mfsi_library(NAME <layer> DEPS <targets...> [OWN_UNIT <sources...>])
 # One static library per layer, made of every .cpp in the folder (CONFIGURE_DEPENDS, so a new
 # file needs no CMake edit). A layer with no sources yet is a header-only INTERFACE library.
+# OWN_UNIT: sources a unity build (CMAKE_UNITY_BUILD, the CUDA build of scripts/build-variant.sh)
+# compiles on their own, not batched with the others: those whose file-scope names (a using-
+# directive, a helper in an anonymous namespace) would clash with or leak into another source.
 function(mfsi_library)
-  cmake_parse_arguments(L "" "NAME" "DEPS" ${ARGN})
+  cmake_parse_arguments(L "" "NAME" "DEPS;OWN_UNIT" ${ARGN})
   file(GLOB_RECURSE srcs CONFIGURE_DEPENDS ${CMAKE_CURRENT_SOURCE_DIR}/*.cpp)
   set(target mfsi_${L_NAME})
   if(srcs)
     add_library(${target} STATIC ${srcs})
+    if(L_OWN_UNIT)
+      set_source_files_properties(${L_OWN_UNIT} PROPERTIES SKIP_UNITY_BUILD_INCLUSION ON)
+    endif()
     target_include_directories(${target} PUBLIC
       $<BUILD_INTERFACE:${PROJECT_SOURCE_DIR}> $<INSTALL_INTERFACE:${CMAKE_INSTALL_INCLUDEDIR}/mfsi>)
     target_link_libraries(${target} PUBLIC ${L_DEPS})

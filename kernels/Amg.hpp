@@ -40,7 +40,8 @@
 /// complexity 1.5-1.6. perf/bench_linsolve, defaults, one thread: 8 / 8 / 9 iterations at
 /// 32^3 / 64^3 / 128^3, 0.69 / 7.6 / 62 ms per iteration (first-kind degree 3 before: 8 / 9 / 9,
 /// 0.84 / 7.9 / 74 ms). The figures below are from earlier defaults (first-kind Chebyshev of
-/// degree 3 or 2, damping 4/3).
+/// degree 3 or 2, damping 4/3); with today's defaults greedy aggregation takes 13 iterations at
+/// 64^3 where lattice cubes take 9 (perf/RESULTS.md, distributed AMG section).
 /// perf/bench_linsolve PressureSolve (same problem), greedy aggregation: 8 / 9 / 10 iterations at
 /// 32^3 / 64^3 / 128^3 in both precisions (degree 2: 9 / 10 / 12). Per CG iteration on one
 /// thread, float cycle vs double cycle: 64^3 11.5 vs 17.1 ms, 128^3 97 vs 133 ms

@@ -10,7 +10,8 @@
 namespace mfsi::coupling {
 
 namespace {
-IndexView toDevice(const std::vector<lid_t>& v, const std::string& label, lid_t shift) {
+/// A device copy of `v` less `shift`.
+IndexView toDeviceShifted(const std::vector<lid_t>& v, const std::string& label, lid_t shift) {
   IndexView d(label, v.size());
   auto h = Kokkos::create_mirror_view(d);
   for (std::size_t i = 0; i < v.size(); ++i) h(i) = v[i] - shift;
@@ -29,9 +30,9 @@ MembraneInterface makeMembraneInterface(const HexMesh& mesh, const FluidSurfaceM
   MembraneInterface m;
   m.surface = name;
   m.side = side;
-  m.fluidNode = toDevice(surface.fluidNode, "mfsi::coupling::interface::fluidNode", 0);
-  m.front = toDevice(surface.masterFace, "mfsi::coupling::interface::front", nIn);
-  m.back = side == InterfaceSide::Baffle ? toDevice(surface.slaveFace, "mfsi::coupling::interface::back", nIn)
+  m.fluidNode = toDeviceShifted(surface.fluidNode, "mfsi::coupling::interface::fluidNode", 0);
+  m.front = toDeviceShifted(surface.masterFace, "mfsi::coupling::interface::front", nIn);
+  m.back = side == InterfaceSide::Baffle ? toDeviceShifted(surface.slaveFace, "mfsi::coupling::interface::back", nIn)
                                          : IndexView("mfsi::coupling::interface::back", 0);
   return m;
 }
@@ -102,8 +103,8 @@ ElementGraph elementGraph(const std::vector<std::array<lid_t, 4>>& elements, con
     off[e + 1] = static_cast<lid_t>(list.size());
   }
   ElementGraph g;
-  g.offsets = toDevice(off, "mfsi::coupling::interface::elementOffsets", 0);
-  g.neighbours = toDevice(list, "mfsi::coupling::interface::elementNeighbours", 0);
+  g.offsets = toDeviceShifted(off, "mfsi::coupling::interface::elementOffsets", 0);
+  g.neighbours = toDeviceShifted(list, "mfsi::coupling::interface::elementNeighbours", 0);
   g.area = RealView("mfsi::coupling::interface::elementArea", areas.size());
   auto ha = Kokkos::create_mirror_view(g.area);
   for (std::size_t e = 0; e < areas.size(); ++e) ha(e) = areas[e];

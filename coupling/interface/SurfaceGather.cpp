@@ -24,14 +24,6 @@ FaceKey faceKey(const FaceNodes& fn, const Gid& gid, lid_t f) {
   return k;
 }
 
-IndexView toDevice(const std::vector<lid_t>& v, const std::string& label) {
-  IndexView d(label, v.size());
-  auto h = Kokkos::create_mirror_view(d);
-  for (std::size_t i = 0; i < v.size(); ++i) h(i) = v[i];
-  Kokkos::deep_copy(d, h);
-  return d;
-}
-
 /// Slot values packed per slot: pressure, vector area (3), area, centroid (3).
 constexpr int kGeometryWidth = 8;
 

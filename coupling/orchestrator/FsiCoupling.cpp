@@ -24,11 +24,11 @@ namespace {
 constexpr double kResidualGrowthLimit = 1e3;
 
 /// Device flat vector -> a slice of a host interface vector, and back.
-void toHost(const ConstRealView& d, InterfaceVector& x, Eigen::Index offset) {
+void copySegmentToHost(const ConstRealView& d, InterfaceVector& x, Eigen::Index offset) {
   auto h = Kokkos::create_mirror_view_and_copy(HostSpace(), d);
   for (std::size_t i = 0; i < h.extent(0); ++i) x[offset + static_cast<Eigen::Index>(i)] = h(i);
 }
-void toDevice(const InterfaceVector& x, Eigen::Index offset, const RealView& d) {
+void copySegmentToDevice(const InterfaceVector& x, Eigen::Index offset, const RealView& d) {
   auto h = Kokkos::create_mirror_view(d);
   for (std::size_t i = 0; i < h.extent(0); ++i) h(i) = x[offset + static_cast<Eigen::Index>(i)];
   Kokkos::deep_copy(d, h);
@@ -318,7 +318,7 @@ void FsiCoupling::checkChamberVolume(const InterfaceVector& x) {
   if (chamber_.panel < 0) return;
   Panel& p = panels_[chamber_.panel];
   MembraneSolver& s = p.module->solver();
-  toDevice(x, p.offset, p.iterate);
+  copySegmentToDevice(x, p.offset, p.iterate);
   const double miss = std::abs(s.enclosedVolume(p.iterate) - s.volumeConstraint().target);
   last_.volumeMiss = std::max(last_.volumeMiss, miss);
 }
@@ -718,7 +718,7 @@ void FsiCoupling::shareSolve(Panel& p, double t1, double dt) {
 void FsiCoupling::gatherTrial(InterfaceVector& xt) const {
   for (const Panel& p : panels_) {
     MembraneSolver& s = p.module->solver();
-    toHost(p.dynamic ? s.trialDisplacement() : s.displacement(), xt, p.offset);
+    copySegmentToHost(p.dynamic ? s.trialDisplacement() : s.displacement(), xt, p.offset);
   }
   if (!bodies_.empty()) xt.segment(bodyOffset_, rigid_->system().nDof()) = rigid_->system().q();
 }
@@ -728,18 +728,18 @@ void FsiCoupling::setTrial(InterfaceVector& x) {
     Panel& p = panels_[i];
     MembraneSolver& s = p.module->solver();
     if (p.dynamic) {
-      toDevice(x, p.offset, p.iterate);
+      copySegmentToDevice(x, p.offset, p.iterate);
       if (static_cast<int>(i) == chamber_.panel) {
         // A relaxed iterate misses the volume to second order in its update: the fluid must get one
         // it can follow.
         s.projectOntoVolume(p.iterate);
-        toHost(p.iterate, x, p.offset);
+        copySegmentToHost(p.iterate, x, p.offset);
         last_.volumeMiss =
             std::max(last_.volumeMiss, std::abs(s.enclosedVolume(p.iterate) - s.volumeConstraint().target));
       }
       s.setTrialDisplacement(p.iterate);
     } else {
-      toDevice(x, p.offset, s.displacement());
+      copySegmentToDevice(x, p.offset, s.displacement());
     }
   }
 }
@@ -816,7 +816,7 @@ void FsiCoupling::moveMesh(const InterfaceVector& x) {
     ScopedTimer timer(timers_, "coupling.transfer");
     placeBodies(x);
     for (Panel& p : panels_) {
-      toDevice(x, p.offset, p.iterate);
+      copySegmentToDevice(x, p.offset, p.iterate);
       if (p.mounted)
         p.parents.displacement(exec_, p.module->solver().mesh().referencePoints(), p.iterate, p.iface.fluidNode,
                                smoother_->displacement());
@@ -895,7 +895,7 @@ void FsiCoupling::advance(const TimeState& t) {
   updateLoads(scale, false, t.dt, true);  // the loads of the fluid at t_n (the structure goes first)
   if (options_.extrapolatedPredictor) extrapolateLoads();
   InterfaceVector x(size_), xt(size_), good(size_);
-  for (const Panel& p : panels_) toHost(p.module->solver().displacement(), good, p.offset);  // the mesh is there
+  for (const Panel& p : panels_) copySegmentToHost(p.module->solver().displacement(), good, p.offset);  // the mesh is there
   acceleration_->beginStep();
   const bool implicit = options_.scheme == CouplingScheme::Implicit;
   // The structure goes first, on the loads of t_n: its answer is the predictor x_1 (and the whole
@@ -956,7 +956,7 @@ void FsiCoupling::advance(const TimeState& t) {
     // The fluid mesh ends the step at `good` (the last iterate moved to): the next step's start.
     Panel& p = panels_[chamber_.panel];
     MembraneSolver& s = p.module->solver();
-    toDevice(good, p.offset, p.iterate);
+    copySegmentToDevice(good, p.offset, p.iterate);
     const double v = s.enclosedVolume(p.iterate);
     chamber_.sweptLast = v - chamber_.volumeStart;
     chamber_.volumeStart = v;
