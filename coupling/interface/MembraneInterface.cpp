@@ -10,7 +10,7 @@
 namespace mfsi::coupling {
 
 namespace {
-/// A device copy of `v` less `shift`.
+/// A device copy of `v`, each value less `shift` (boundary face ids to patch-local ones).
 IndexView toDeviceShifted(const std::vector<lid_t>& v, const std::string& label, lid_t shift) {
   IndexView d(label, v.size());
   auto h = Kokkos::create_mirror_view(d);
@@ -30,7 +30,7 @@ MembraneInterface makeMembraneInterface(const HexMesh& mesh, const FluidSurfaceM
   MembraneInterface m;
   m.surface = name;
   m.side = side;
-  m.fluidNode = toDeviceShifted(surface.fluidNode, "mfsi::coupling::interface::fluidNode", 0);
+  m.fluidNode = toDevice(surface.fluidNode, "mfsi::coupling::interface::fluidNode");
   m.front = toDeviceShifted(surface.masterFace, "mfsi::coupling::interface::front", nIn);
   m.back = side == InterfaceSide::Baffle ? toDeviceShifted(surface.slaveFace, "mfsi::coupling::interface::back", nIn)
                                          : IndexView("mfsi::coupling::interface::back", 0);
@@ -103,8 +103,8 @@ ElementGraph elementGraph(const std::vector<std::array<lid_t, 4>>& elements, con
     off[e + 1] = static_cast<lid_t>(list.size());
   }
   ElementGraph g;
-  g.offsets = toDeviceShifted(off, "mfsi::coupling::interface::elementOffsets", 0);
-  g.neighbours = toDeviceShifted(list, "mfsi::coupling::interface::elementNeighbours", 0);
+  g.offsets = toDevice(off, "mfsi::coupling::interface::elementOffsets");
+  g.neighbours = toDevice(list, "mfsi::coupling::interface::elementNeighbours");
   g.area = RealView("mfsi::coupling::interface::elementArea", areas.size());
   auto ha = Kokkos::create_mirror_view(g.area);
   for (std::size_t e = 0; e < areas.size(); ++e) ha(e) = areas[e];

@@ -47,7 +47,7 @@ struct AmgComparison {
 /// AMG-CG on the whole mesh (one process, default options) and on every rank's part (`options`);
 /// returns the two iteration counts and the levels after checking the answers agree to 1e-9.
 inline AmgComparison checkDistributedAmg(const HexMeshInput& in, const std::vector<int>& cellRank,
-                                               const DistributedAmgOptions& options = {}) {
+                                         const DistributedAmgOptions& options = {}) {
   int ranks = 1, rank = 0;
   MPI_Comm_size(MPI_COMM_WORLD, &ranks);
   MPI_Comm_rank(MPI_COMM_WORLD, &rank);
