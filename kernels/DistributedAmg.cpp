@@ -15,6 +15,7 @@
 #include <limits>
 #include <map>
 #include <memory>
+#include <set>
 #include <string>
 #include <type_traits>
 
@@ -345,12 +346,50 @@ void denseRows(const ExecSpace& exec, const Kokkos::View<double**, MemSpace>& in
       });
 }
 
+/// Bytes of distinct allocations (DistributedAmg::memoryBytes): a View that two parts share (a
+/// double cycle's vectors are its levels') counts once.
+struct ByteCount {
+  std::set<const void*> seen;
+  std::size_t bytes = 0;
+  template <class V>
+  void view(const V& v) {
+    if (v.data() != nullptr && seen.insert(static_cast<const void*>(v.data())).second)
+      bytes += v.size() * sizeof(typename V::value_type);
+  }
+  template <class T>
+  void vector(const std::vector<T>& v) {
+    bytes += v.capacity() * sizeof(T);
+  }
+  void runs(const CsrRowRuns& R) {
+    view(R.start);
+    view(R.offsetsAt);
+    view(R.offsets);
+    view(R.blockStart);
+  }
+  void csr(const CsrMatrix& M) {
+    view(M.rowPtr);
+    view(M.colIdx);
+    view(M.diagIdx);
+    view(M.values);
+    runs(M.runs);
+  }
+  template <class S>
+  void csr(const CycleMat<S>& M) {
+    view(M.rowPtr);
+    view(M.colIdx);
+    view(M.val);
+    runs(M.runs);
+  }
+};
+
 /// Coarsest-level gathers made by every DistributedAmg of this process (DistributedAmg::coarseGathers).
 std::int64_t gCoarseGathers = 0;
 
 }  // namespace
 
 struct DistributedAmg::Impl {
+  /// A level as the set-up builds it; after set-up only its sizes, halo, lambda_max and the
+  /// vectors the coarsest solve or a double cycle shares are left (releaseSetupData).
   struct Level {
     HostCsr hA;
     std::vector<gid_t> gid;  ///< local -> global
@@ -690,31 +729,86 @@ struct DistributedAmg::Impl {
   }
 
   /// The cycle's levels in precision S: the operators (float: rounded copies sharing the
-  /// sparsity and row runs), inverse diagonals and work vectors.
+  /// sparsity and row runs), inverse diagonals and work vectors. The coarsest level, solved in
+  /// double from its level's own b into its x, holds only its right-hand side and solution.
   template <class S>
   void buildCycle(const ExecSpace& exec, std::vector<CycleLevel<S>>& cycle) {
     cycle.clear();
     for (std::size_t l = 0; l < levels.size(); ++l) {
       Level& L = levels[l];
+      const bool coarsest = l + 1 == levels.size();
       CycleLevel<S> C;
       const std::string label = "mfsi::kernels::damg::level" + std::to_string(l);
       if constexpr (std::is_same<S, double>::value) {
-        C.invDiag = L.invDiag;
         C.x = L.x;
         C.b = L.b;
-        C.r = L.r;
-        C.d = L.d;
+        if (!coarsest) {
+          C.invDiag = L.invDiag;
+          C.r = L.r;
+          C.d = L.d;
+        }
       } else {
-        C.invDiag = SView<S>(label + "::invDiag::float", L.hA.nRows);
-        convert<S>(exec, L.hA.nRows, L.invDiag, C.invDiag);
-        for (SView<S>* v : {&C.x, &C.b, &C.r, &C.d}) *v = SView<S>(label + "::work::float", L.hA.nCols);
+        for (SView<S>* v : {&C.x, &C.b}) *v = SView<S>(label + "::work::float", L.hA.nCols);
+        if (!coarsest) {
+          C.invDiag = SView<S>(label + "::invDiag::float", L.hA.nRows);
+          convert<S>(exec, L.hA.nRows, L.invDiag, C.invDiag);
+          for (SView<S>* v : {&C.r, &C.d}) *v = SView<S>(label + "::work::float", L.hA.nCols);
+        }
       }
-      C.A = cycleMat<S>(exec, L.A);
-      if (l + 1 < levels.size()) {
+      if (!coarsest) {
+        C.A = cycleMat<S>(exec, L.A);
         C.P = cycleMat<S>(exec, L.P);
         C.R = cycleMat<S>(exec, L.R);
       }
       cycle.push_back(std::move(C));
+    }
+  }
+
+  /// After set-up, drop what only the set-up uses: the host copies of the levels, their global
+  /// ids and lattices, the level matrices, inverse diagonals and smoothing vectors (the cycle
+  /// holds those it uses), and under a float cycle the double b and x of every level but the
+  /// coarsest (its solve is in double). The next set-up builds every level again.
+  void releaseSetupData() {
+    for (std::size_t l = 0; l < levels.size(); ++l) {
+      Level& L = levels[l];
+      std::vector<lid_t>().swap(L.hA.ptr);
+      std::vector<lid_t>().swap(L.hA.col);
+      std::vector<double>().swap(L.hA.val);
+      std::vector<gid_t>().swap(L.gid);
+      L.lattice = LatticeRows{};
+      L.A = CsrMatrix{};
+      L.P = CsrMatrix{};
+      L.R = CsrMatrix{};
+      L.invDiag = L.r = L.d = RealView();
+      if (opt.mixedPrecision && l + 1 < levels.size()) L.x = L.b = RealView();
+    }
+  }
+
+  std::size_t memoryBytes() const {
+    ByteCount c;
+    c.vector(fineIds);
+    for (const Level& L : levels) {
+      c.vector(L.hA.ptr);
+      c.vector(L.hA.col);
+      c.vector(L.hA.val);
+      c.vector(L.gid);
+      c.vector(L.lattice.at);
+      for (const CsrMatrix* M : {&L.A, &L.P, &L.R}) c.csr(*M);
+      for (const RealView* v : {&L.invDiag, &L.x, &L.b, &L.r, &L.d}) c.view(*v);
+    }
+    count(c, cycleDouble);
+    count(c, cycleFloat);
+    c.view(coarseInv);
+    c.view(coarseAll);
+    c.view(coarseOut);
+    return c.bytes + (coarseAmg ? coarseAmg->memoryBytes() : 0);
+  }
+
+  template <class S>
+  static void count(ByteCount& c, const std::vector<CycleLevel<S>>& cycle) {
+    for (const CycleLevel<S>& C : cycle) {
+      for (const CycleMat<S>* M : {&C.A, &C.P, &C.R}) c.csr(*M);
+      for (const SView<S>* v : {&C.invDiag, &C.x, &C.b, &C.r, &C.d}) c.view(*v);
     }
   }
 
@@ -829,7 +923,10 @@ void DistributedAmg::setup(const ExecSpace& exec, const CsrMatrix& A) {
     m.buildCycle(exec, m.cycleFloat);
   else
     m.buildCycle(exec, m.cycleDouble);
+  m.releaseSetupData();
 }
+
+std::size_t DistributedAmg::memoryBytes() const { return impl_->memoryBytes(); }
 
 void DistributedAmg::apply(const ExecSpace& exec, const ConstRealView& r, const RealView& z) {
   Impl& m = *impl_;

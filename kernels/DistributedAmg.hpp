@@ -84,6 +84,12 @@ class DistributedAmg final : public Preconditioner {
   static std::int64_t coarseGathers();
 
   const std::vector<DistributedAmgLevelInfo>& levels() const;
+  /// \brief Bytes this rank's hierarchy holds (device views and host arrays; a view two of its
+  /// parts share counted once; the halos' buffers not counted). After set-up it holds what the
+  /// cycle uses: the operators, prolongators, restrictions, inverse diagonals and work vectors in
+  /// the cycle's precision, the coarsest level's solve, and the copy of the fine matrix's
+  /// sparsity (its values in a float cycle are a rounded copy).
+  std::size_t memoryBytes() const;
 
  private:
   struct Impl;

@@ -117,6 +117,8 @@ int main(int argc, char** argv) {
     int messages = halo.sendMessages(), allMessages = 0;
     MPI_Reduce(&bytes, &allBytes, 1, MPI_LONG_LONG, MPI_SUM, 0, MPI_COMM_WORLD);
     MPI_Reduce(&messages, &allMessages, 1, MPI_INT, MPI_SUM, 0, MPI_COMM_WORLD);
+    long long held = static_cast<long long>(amg.memoryBytes()), allHeld = 0;
+    MPI_Reduce(&held, &allHeld, 1, MPI_LONG_LONG, MPI_SUM, 0, MPI_COMM_WORLD);
     if (rank == 0) {
       std::printf("n=%d^3 %s %s %s ranks=%d threads=%d edgecut=%lld | distributed AMG-CG to 1e-8: %d iterations (%s), "
                   "set-up %.3f s, solve %.3f s (%.2f ms per iteration) | levels:",
@@ -124,7 +126,10 @@ int main(int argc, char** argv) {
                   static_cast<long long>(part.edgeCut), r.iterations, toString(r.status), tSetup, tSolve,
                   1e3 * tSolve / std::max(1, r.iterations));
       for (const auto& l : amg.levels()) std::printf(" %lld", static_cast<long long>(l.rows));
-      std::printf(" | fine halo: %d messages, %lld bytes per exchange (all ranks)\n", allMessages, allBytes);
+      std::printf(" | fine halo: %d messages, %lld bytes per exchange (all ranks) | hierarchy %.1f MB, %.0f bytes per "
+                  "fine row (all ranks)\n",
+                  allMessages, allBytes, 1e-6 * static_cast<double>(allHeld),
+                  static_cast<double>(allHeld) / (static_cast<double>(n) * n * n));
     }
     if (ranks == 1 && rank == 0) {
       // The one-rank AMG of the fluid, same system, for scale.

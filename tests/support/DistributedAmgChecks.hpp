@@ -12,6 +12,7 @@ namespace mfsi::test {
 struct AmgSolve {
   LaplacianSolve solve;
   std::vector<DistributedAmgLevelInfo> levels;
+  std::size_t bytes = 0;  ///< DistributedAmg::memoryBytes after the solve
 };
 
 inline AmgSolve solveWithAmg(MPI_Comm comm, const HexMesh& mesh, const HaloPlan& plan, const Halo* halo,
@@ -34,14 +35,16 @@ inline AmgSolve solveWithAmg(MPI_Comm comm, const HexMesh& mesh, const HaloPlan&
   auto hx = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), x);
   for (lid_t c = 0; c < mesh.nOwnedCells(); ++c) s.solve.x[gid(c)] = hx(c);
   s.levels = amg.levels();
+  s.bytes = amg.memoryBytes();
   return s;
 }
 
 /// What checkDistributedAmg measured: the iterations on one process and on the ranks, and this
-/// rank's levels of the distributed hierarchy.
+/// rank's levels of the distributed hierarchy and the bytes they hold.
 struct AmgComparison {
   int one = 0, many = 0;
   std::vector<DistributedAmgLevelInfo> levels;
+  std::size_t bytes = 0;
 };
 
 /// AMG-CG on the whole mesh (one process, default options) and on every rank's part (`options`);
@@ -80,7 +83,7 @@ inline AmgComparison checkDistributedAmg(const HexMeshInput& in, const std::vect
     for (const auto& l : dist.levels) std::printf(" %lld", static_cast<long long>(l.rows));
     std::printf("\n");
   }
-  return {one.solve.iterations, dist.solve.iterations, dist.levels};
+  return {one.solve.iterations, dist.solve.iterations, dist.levels, dist.bytes};
 }
 
 /// The coarsest level gathered early (at most 5,000 rows) and solved by a one-process AMG of the
