@@ -268,18 +268,14 @@ double FluidModule::pressureDifference(const Vec3& from, const Vec3& to, const s
 
 void FluidModule::addOutputFields(io::FieldFrame& frame) {
   io::OutputGrid* grid = frame.find("mesh");
-  if (comm_ == MPI_COMM_NULL && !grid) return;
-  // On a decomposed mesh every rank sends its owned cells; rank 0 holds the frame's grid.
+  if (!grid) return;
+  // On a decomposed mesh the grid is this rank's part: its owned cells, first in the local order.
   const std::size_t n = static_cast<std::size_t>(comm_ == MPI_COMM_NULL ? solver_.mesh().nCells() : ownedIds_.size());
-  auto add = [&](const char* name, int components, std::vector<double> values) {
-    if (comm_ != MPI_COMM_NULL) values = gatherByGlobalId(comm_, 0, ownedIds_, values, components, globalCells_);
-    if (grid) grid->addCellField(name, components, std::move(values));
-  };
-  add("U", 3, io::hostValues(solver_.velocity(), n));
-  add("p", 1, io::hostValues(solver_.pressure(), n));
+  grid->addCellField("U", 3, io::hostValues(solver_.velocity(), n));
+  grid->addCellField("p", 1, io::hostValues(solver_.pressure(), n));
   if (means_) {
-    add("UMean", 3, io::hostValues(means_->velocity(), n));
-    add("pMean", 1, io::hostValues(means_->pressure(), n));
+    grid->addCellField("UMean", 3, io::hostValues(means_->velocity(), n));
+    grid->addCellField("pMean", 1, io::hostValues(means_->pressure(), n));
   }
 }
 

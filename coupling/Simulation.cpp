@@ -239,12 +239,44 @@ void Simulation::meshMetrics(std::map<std::string, double>& m) const {
   m["mesh.patches"] = static_cast<double>(mesh_.patches().size());
 }
 
+io::OutputGrid Simulation::meshPart() const {
+  io::OutputGrid g;
+  g.name = "mesh";
+  g.shape = io::CellShape::Hexahedron;
+  g.decomposed = true;
+  g.globalPoints = static_cast<std::size_t>(mesh_.nNodes());
+  g.globalCells = static_cast<std::size_t>(mesh_.nCells());
+  const std::size_t nNodes = static_cast<std::size_t>(localMesh_.nOwnedNodes());
+  const std::size_t nCells = static_cast<std::size_t>(localMesh_.nOwnedCells());
+  auto nodeIds = Kokkos::create_mirror_view_and_copy(HostSpace(), localMesh_.nodeGlobalIds());
+  auto cellIds = Kokkos::create_mirror_view_and_copy(HostSpace(), localMesh_.cellGlobalIds());
+  g.pointRows.assign(nodeIds.data(), nodeIds.data() + nNodes);
+  g.cellRows.assign(cellIds.data(), cellIds.data() + nCells);
+  g.points = io::hostValues(localMesh_.points(), nNodes);
+  const std::vector<double> x0 = io::hostValues(localMesh_.referencePoints(), nNodes);
+  std::vector<double> d(g.points.size());
+  for (std::size_t i = 0; i < d.size(); ++i) d[i] = g.points[i] - x0[i];
+  for (double c : io::hostValues(localMesh_.cellNodes(), nCells))
+    g.cells.push_back(static_cast<std::int64_t>(nodeIds(static_cast<std::size_t>(c))));  // global points
+  RealView quality("mfsi::output::scaledJacobian", static_cast<std::size_t>(localMesh_.nCells()));
+  cellScaledJacobians(ExecSpace(), localMesh_, quality);
+  g.addPointField("meshDisplacement", 3, std::move(d), true, true);
+  g.addCellField("scaledJacobian", 1, io::hostValues(quality, nCells), true, true);
+  return g;
+}
+
 io::FieldFrame Simulation::fieldFrame(double time, long long step) {
   io::FieldFrame frame;
   frame.time = time;
   frame.step = step;
-  gatherPoints();  // the moved mesh, for rank 0 to write
-  if (hasMesh_ && rank_ == 0) {
+  if (hasMesh_ && ranks_ > 1) {
+    // Each rank writes its own part of the mesh (FieldSeries); the whole mesh's points reach rank
+    // 0 only for a module that reads them there.
+    bool gather = false;
+    for (const auto& m : modules_) gather = gather || m->outputReadsWholeMesh();
+    if (gather) gatherPoints();
+    frame.grids.push_back(meshPart());
+  } else if (hasMesh_) {
     io::OutputGrid g;
     g.name = "mesh";
     g.shape = io::CellShape::Hexahedron;
@@ -292,13 +324,13 @@ RunResult Simulation::run(const std::string& outDir, bool terminal, bool continu
   if (writer)
     for (Module* m : reporting_) m->openOutput(outDir, outputStart);
   Progress progress(nSteps, time_.endTime, terminal, writer ? 0 : -1);
-  io::FieldSeries fields(outDir);
+  io::FieldSeries fields(outDir, ranks_ > 1 ? MPI_COMM_WORLD : MPI_COMM_NULL);
   if (continueFiles) fields.restore(start_.fields, ts.step);
   long long lastFrameStep = start_.restored ? start_.lastFrameStep : -1;
   auto writeFrame = [&] {
     ScopedTimer t(timers_, "output");
     io::FieldFrame frame = fieldFrame(ts.time, ts.step);
-    if (writer) fields.write(frame);
+    fields.write(frame);  // collective on several ranks
     lastFrameStep = ts.step;
   };
   double nextFrameTime = start_.restored ? start_.nextFrameTime : fieldOutput_.interval;

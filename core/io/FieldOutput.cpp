@@ -3,14 +3,17 @@
 #include "core/Error.hpp"
 #include "core/RunLog.hpp"
 #include "core/io/Hdf5File.hpp"
+#include "core/io/RowWriter.hpp"
 
 #include <algorithm>
 #include <cstdio>
 #include <filesystem>
 #include <iomanip>
+#include <optional>
 #include <sstream>
 #include <stdexcept>
 #include <system_error>
+#include <type_traits>
 
 namespace mfsi::io {
 
@@ -129,73 +132,248 @@ OutputGrid* FieldFrame::find(const std::string& name) {
   return nullptr;
 }
 
-FieldSeries::FieldSeries(std::string runDir) : dir_(std::move(runDir)), indexPath_(dir_ + "/fields.xdmf") {}
+FieldSeries::FieldSeries(std::string runDir, MPI_Comm comm)
+    : dir_(std::move(runDir)), indexPath_(dir_ + "/fields.xdmf"), comm_(comm) {
+  if (comm_ != MPI_COMM_NULL) {
+    MPI_Comm_rank(comm_, &rank_);
+    MPI_Comm_size(comm_, &ranks_);
+  }
+}
 
 std::string FieldSeries::framePath(int i) const { return dir_ + "/" + entries_.at(static_cast<std::size_t>(i)).file; }
 
-void FieldSeries::write(const FieldFrame& frame) {
-  std::error_code ec;
-  fs::create_directories(dir_ + "/fields", ec);
-  if (ec) throw OutputError("cannot create '" + dir_ + "/fields': " + ec.message());
+namespace {
+std::string frameFile(long long step) {
   char name[64];
-  std::snprintf(name, sizeof name, "fields/fields_%06lld.h5", frame.step);
-  Entry entry{frame.time, name, {}, frame.step};
+  std::snprintf(name, sizeof name, "fields/fields_%06lld.h5", step);
+  return name;
+}
 
+/// Rank 0's `text` on every rank of `comm` (collective).
+std::string fromRankZero(MPI_Comm comm, const std::string& text) {
+  unsigned long long n = text.size();
+  MPI_Bcast(&n, 1, MPI_UNSIGNED_LONG_LONG, 0, comm);
+  std::string out = text;
+  out.resize(n);
+  MPI_Bcast(out.data(), static_cast<int>(n), MPI_CHAR, 0, comm);
+  return out;
+}
+
+void makeFieldsFolder(const std::string& dir) {
+  std::error_code ec;
+  fs::create_directories(dir + "/fields", ec);
+  if (ec) throw OutputError("cannot create '" + dir + "/fields': " + ec.message());
+}
+}  // namespace
+
+void FieldSeries::putGrid(Hdf5File* h5, const OutputGrid& g, bool samePoints, bool sameCells, Entry& entry,
+                          std::vector<std::pair<std::string, Written>>& pending, std::vector<RowPiece>& pieces) const {
+  if (g.decomposed && g.shape != CellShape::Hexahedron)
+    throw std::logic_error("output grid '" + g.name + "': only a hexahedral grid may be decomposed");
+  Topology topo = topologyOf(g);
+  const std::size_t nPoints = g.decomposed ? g.globalPoints : g.nPoints();
+  const std::size_t nCells = g.decomposed ? g.globalCells : g.nCells();
+  if (g.decomposed) topo.dims = {nCells, 8};
+  const std::string root = "/" + g.name;
+  const auto known = written_.find(g.name);
+  Written next;  // where this grid's points, cells and geometric fields are once this frame is on disk
+  std::string topologyDims;
+  for (std::size_t d : topo.dims) topologyDims += (topologyDims.empty() ? "" : " ") + std::to_string(d);
+  GridEntry ge{g.name, g.shape, nPoints, nCells, topo.type, topologyDims, {}, {}, {}};
+  // A decomposed grid's datasets are reserved in the file (on the rank that lays it out) and
+  // written by every rank, each its own rows; a whole grid's are written here.
+  auto put = [&](const std::string& dataset, const auto& values, std::vector<std::size_t> dims, bool pointRows) {
+    if (!g.decomposed) {
+      h5->write(dataset, values, dims);
+      return;
+    }
+    constexpr bool integers = std::is_same_v<std::decay_t<decltype(values)>, std::vector<std::int64_t>>;
+    if (h5) h5->reserve(dataset, dims, integers);
+    const std::vector<std::int64_t>& rows = pointRows ? g.pointRows : g.cellRows;
+    RowPiece piece;
+    piece.width = dims.size() > 1 ? dims[1] : 1;
+    piece.rows = rows.data();
+    piece.nRows = rows.size();
+    piece.values = values.data();
+    if (values.size() != rows.size() * piece.width)
+      throw std::logic_error("output grid '" + g.name + "': " + dataset + " has " + std::to_string(values.size()) +
+                             " values for " + std::to_string(rows.size()) + " rows");
+    pieces.push_back(piece);
+  };
+  if (samePoints) {
+    next.pointsFile = known->second.pointsFile;
+  } else {
+    put(root + "/points", g.points, {nPoints, 3}, true);
+    next.pointsFile = entry.file;
+    next.points = g.points;
+  }
+  if (sameCells) {
+    next.topologyFile = known->second.topologyFile;
+  } else {
+    if (g.decomposed)
+      put(root + "/topology", g.cells, topo.dims, false);  // the pieces point at the grid's own values
+    else
+      put(root + "/topology", topo.values, topo.dims, false);
+    next.topologyFile = entry.file;
+    next.topology = std::move(topo.values);
+  }
+  ge.files["points"] = next.pointsFile;
+  ge.files["topology"] = next.topologyFile;
+  auto fields = [&](const std::vector<OutputField>& list, const std::string& group, std::size_t n,
+                    std::vector<OutputField>& into) {
+    for (const auto& f : list) {
+      const std::string key = group + "/" + f.name;
+      const std::string* earlier = nullptr;
+      if (f.geometric && samePoints && sameCells) {
+        const auto it = known->second.geometricFiles.find(key);
+        if (it != known->second.geometricFiles.end()) earlier = &it->second;
+      }
+      if (earlier) {
+        ge.files[key] = *earlier;
+      } else {
+        put(root + "/" + key, f.values, shapeOf(n, f), group == "point");
+        ge.files[key] = entry.file;
+      }
+      if (f.geometric) next.geometricFiles[key] = ge.files[key];
+      into.push_back({f.name, f.components, {}, f.vector, f.geometric});
+    }
+  };
+  fields(g.pointFields, "point", nPoints, ge.pointFields);
+  fields(g.cellFields, "cell", nCells, ge.cellFields);
+  pending.emplace_back(g.name, std::move(next));
+  entry.grids.push_back(std::move(ge));
+}
+
+void FieldSeries::write(const FieldFrame& frame) {
+  if (ranks_ > 1) return writeShared(frame);
+  makeFieldsFolder(dir_);
+  Entry entry{frame.time, frameFile(frame.step), {}, frame.step};
   Hdf5File h5 = Hdf5File::create(dir_ + "/" + entry.file);
   h5.writeAttribute("time", frame.time);
   h5.writeAttribute("step", static_cast<double>(frame.step));
   std::vector<std::pair<std::string, Written>> pending;
+  std::vector<RowPiece> pieces;
   for (const OutputGrid& g : frame.grids) {
-    Topology topo = topologyOf(g);
-    const std::string root = "/" + g.name;
+    if (g.decomposed) throw std::logic_error("output grid '" + g.name + "' is decomposed on a one-rank series");
     const auto known = written_.find(g.name);
-    Written next;  // where this grid's points, cells and geometric fields are once this frame is on disk
-    std::string topologyDims;
-    for (std::size_t d : topo.dims) topologyDims += (topologyDims.empty() ? "" : " ") + std::to_string(d);
-    GridEntry ge{g.name, g.shape, g.nPoints(), g.nCells(), topo.type, topologyDims, {}, {}, {}};
     const bool samePoints = known != written_.end() && known->second.points == g.points;
-    const bool sameCells = known != written_.end() && known->second.topology == topo.values;
-    if (samePoints) {
-      next.pointsFile = known->second.pointsFile;
-    } else {
-      h5.write(root + "/points", g.points, {g.nPoints(), 3});
-      next.pointsFile = entry.file;
-      next.points = g.points;
-    }
-    if (sameCells) {
-      next.topologyFile = known->second.topologyFile;
-    } else {
-      h5.write(root + "/topology", topo.values, topo.dims);
-      next.topologyFile = entry.file;
-      next.topology = std::move(topo.values);
-    }
-    ge.files["points"] = next.pointsFile;
-    ge.files["topology"] = next.topologyFile;
-    auto fields = [&](const std::vector<OutputField>& list, const std::string& group, std::size_t n,
-                      std::vector<OutputField>& into) {
-      for (const auto& f : list) {
-        const std::string key = group + "/" + f.name;
-        const std::string* earlier = nullptr;
-        if (f.geometric && samePoints && sameCells) {
-          const auto it = known->second.geometricFiles.find(key);
-          if (it != known->second.geometricFiles.end()) earlier = &it->second;
-        }
-        if (earlier) {
-          ge.files[key] = *earlier;
-        } else {
-          h5.write(root + "/" + key, f.values, shapeOf(n, f));
-          ge.files[key] = entry.file;
-        }
-        if (f.geometric) next.geometricFiles[key] = ge.files[key];
-        into.push_back({f.name, f.components, {}, f.vector, f.geometric});
-      }
-    };
-    fields(g.pointFields, "point", g.nPoints(), ge.pointFields);
-    fields(g.cellFields, "cell", g.nCells(), ge.cellFields);
-    pending.emplace_back(g.name, std::move(next));
-    entry.grids.push_back(std::move(ge));
+    const bool sameCells = known != written_.end() && known->second.topology == topologyOf(g).values;
+    putGrid(&h5, g, samePoints, sameCells, entry, pending, pieces);
   }
   h5.commit();
+  publish(std::move(entry), pending);
+}
+
+void FieldSeries::writeShared(const FieldFrame& frame) {
+  // The decomposed grids, in the frame's order (the same on every rank); whether each one's
+  // points and cells are those already written is decided over all ranks' parts.
+  std::vector<const OutputGrid*> parts;
+  for (const OutputGrid& g : frame.grids)
+    if (g.decomposed) parts.push_back(&g);
+  std::vector<int> same(2 * parts.size() + 1);
+  same.back() = static_cast<int>(parts.size());
+  for (std::size_t i = 0; i < parts.size(); ++i) {
+    const auto known = written_.find(parts[i]->name);
+    same[2 * i] = known != written_.end() && known->second.points == parts[i]->points;
+    same[2 * i + 1] = known != written_.end() && known->second.topology == parts[i]->cells;
+  }
+  std::vector<int> low(same.size()), high(same.size());
+  MPI_Allreduce(same.data(), low.data(), static_cast<int>(same.size()), MPI_INT, MPI_MIN, comm_);
+  MPI_Allreduce(same.data(), high.data(), static_cast<int>(same.size()), MPI_INT, MPI_MAX, comm_);
+  if (low.back() != high.back())
+    throw std::logic_error("field output: the ranks' frames hold different numbers of decomposed grids");
+
+  Entry entry{frame.time, frameFile(frame.step), {}, frame.step};
+  const std::string path = dir_ + "/" + entry.file;
+  std::vector<std::pair<std::string, Written>> pending;
+  std::vector<RowPiece> pieces;
+  // Rank 0 lays the file out (its whole grids written, the decomposed ones reserved); the others
+  // list their rows of the same datasets in the same order.
+  std::string failure;
+  std::vector<ReservedDataset> layout;
+  try {
+    std::optional<Hdf5File> h5;
+    if (rank_ == 0) {
+      makeFieldsFolder(dir_);
+      h5.emplace(Hdf5File::createShared(path));
+      h5->writeAttribute("time", frame.time);
+      h5->writeAttribute("step", static_cast<double>(frame.step));
+      for (const OutputGrid& g : frame.grids) {
+        if (g.decomposed) continue;
+        const auto known = written_.find(g.name);
+        const bool samePoints = known != written_.end() && known->second.points == g.points;
+        const bool sameCells = known != written_.end() && known->second.topology == topologyOf(g).values;
+        putGrid(&*h5, g, samePoints, sameCells, entry, pending, pieces);
+      }
+    }
+    for (std::size_t i = 0; i < parts.size(); ++i)
+      putGrid(h5 ? &*h5 : nullptr, *parts[i], low[2 * i] != 0, low[2 * i + 1] != 0, entry, pending, pieces);
+    if (h5) layout = h5->commitLayout();
+    // The index lists the grids in the frame's order, as on one rank (the whole grids were
+    // written first, so that their values lie before the reserved ones).
+    std::stable_sort(entry.grids.begin(), entry.grids.end(), [&](const GridEntry& a, const GridEntry& b) {
+      auto at = [&](const std::string& name) {
+        for (std::size_t i = 0; i < frame.grids.size(); ++i)
+          if (frame.grids[i].name == name) return i;
+        return frame.grids.size();
+      };
+      return at(a.name) < at(b.name);
+    });
+  } catch (const OutputError& e) {
+    failure = e.what();
+  }
+  // Where each reserved dataset lies, from rank 0.
+  std::vector<std::uint64_t> offsets(layout.size() + 1);
+  offsets[0] = failure.empty() ? layout.size() : std::uint64_t(-1);
+  for (std::size_t i = 0; i < layout.size(); ++i) offsets[i + 1] = layout[i].offset;
+  MPI_Bcast(offsets.data(), 1, MPI_UINT64_T, 0, comm_);
+  if (offsets[0] == std::uint64_t(-1)) throw OutputError(fromRankZero(comm_, failure));
+  if (offsets[0] != pieces.size())
+    throw std::logic_error("field output: rank 0 laid out " + std::to_string(offsets[0]) + " datasets, this rank has " +
+                           std::to_string(pieces.size()));
+  offsets.resize(pieces.size() + 1);
+  MPI_Bcast(offsets.data() + 1, static_cast<int>(pieces.size()), MPI_UINT64_T, 0, comm_);
+  for (std::size_t i = 0; i < pieces.size(); ++i) pieces[i].offset = offsets[i + 1];
+  const std::string part = path + ".part";
+  const std::string rows = writeRows(comm_, part, pieces);
+  // Rank 0 names the file and lists it; the other ranks keep their parts' points and cells.
+  std::string published = rows;
+  if (rank_ == 0) {
+    std::error_code ec;
+    if (!published.empty()) {
+      fs::remove(part, ec);
+    } else {
+      fs::rename(part, path, ec);
+      if (ec) {
+        std::error_code ignored;
+        fs::remove(part, ignored);
+        published = "cannot rename '" + part + "' to '" + path + "': " + ec.message();
+      } else {
+        try {
+          publish(std::move(entry), pending);
+        } catch (const OutputError& e) {
+          published = e.what();
+        }
+      }
+    }
+  }
+  int ok = published.empty() ? 1 : 0;
+  MPI_Bcast(&ok, 1, MPI_INT, 0, comm_);
+  if (!ok) throw OutputError(rows.empty() ? fromRankZero(comm_, published) : rows);
+  if (rank_ != 0) {
+    entries_.push_back(Entry{frame.time, entry.file, {}, frame.step});
+    for (auto& [name, next] : pending) {
+      Written& w = written_[name];
+      if (next.pointsFile == entry.file) w.points = std::move(next.points);
+      if (next.topologyFile == entry.file) w.topology = std::move(next.topology);
+      w.pointsFile = next.pointsFile;
+      w.topologyFile = next.topologyFile;
+      w.geometricFiles = std::move(next.geometricFiles);
+    }
+  }
+}
+
+void FieldSeries::publish(Entry entry, std::vector<std::pair<std::string, Written>>& pending) {
   // The frame counts once the index lists it (a checkpoint lists the frames the index does): when
   // the index cannot be written, its previous version stays, without this frame (whose complete
   // file stays unlisted).

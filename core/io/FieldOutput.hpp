@@ -8,12 +8,17 @@
 /// series writes it. A grid's points and cells are written when they change and otherwise referred
 /// to where they were written (a fixed mesh: once, in the first frame). Both files of an output time are written under temporary names and renamed,
 /// so an interrupted run leaves the frames it finished and an XDMF file that lists exactly those.
+#include <mpi.h>
+
 #include <cstdint>
 #include <map>
 #include <string>
 #include <vector>
 
 namespace mfsi::io {
+
+class Hdf5File;
+struct RowPiece;
 
 /// \brief One field on a grid: `components` values per point or per cell, point or cell major.
 /// Three components are a vector (ParaView draws glyphs of it) unless `vector` is false (e.g. the
@@ -36,6 +41,11 @@ enum class CellShape {
 };
 
 /// \brief A grid of one output time: positions (3 per point), cells, point and cell fields.
+///
+/// On a decomposed mesh a grid may be one rank's part of a grid every rank holds a part of
+/// (`decomposed`, hexahedra only): its points and cells are the rank's rows of the whole grid,
+/// `pointRows` and `cellRows` their global rows (each global row on exactly one rank), its cells
+/// name global points, and each rank writes its own rows of the frame's file.
 struct OutputGrid {
   std::string name;
   CellShape shape = CellShape::Point;
@@ -43,6 +53,9 @@ struct OutputGrid {
   std::vector<std::int64_t> cells;
   std::vector<OutputField> pointFields;
   std::vector<OutputField> cellFields;
+  bool decomposed = false;
+  std::vector<std::int64_t> pointRows, cellRows;  ///< decomposed: the global row of each point / cell
+  std::size_t globalPoints = 0, globalCells = 0;  ///< decomposed: the whole grid's sizes
 
   std::size_t nPoints() const { return points.size() / 3; }
   std::size_t nCells() const;
@@ -65,10 +78,13 @@ struct FieldFrame {
 /// \brief The time series of a run: writes frames and keeps the XDMF index in step with them.
 class FieldSeries {
  public:
-  /// Frames go to `<runDir>/fields/`, the index to `<runDir>/fields.xdmf`.
-  explicit FieldSeries(std::string runDir);
+  /// Frames go to `<runDir>/fields/`, the index to `<runDir>/fields.xdmf`. With a communicator
+  /// of several ranks, write() is collective over it: rank 0 lays each frame's file out and
+  /// writes the grids of its own frame that are not decomposed (the others' are ignored), every
+  /// rank writes its rows of the decomposed ones, and rank 0 writes the index.
+  explicit FieldSeries(std::string runDir, MPI_Comm comm = MPI_COMM_NULL);
   /// Write one frame and rewrite the index. Throws OutputError when anything cannot be written
-  /// (the frames written before stay listed and readable).
+  /// (the frames written before stay listed and readable), on every rank of a collective write.
   void write(const FieldFrame& frame);
   int frames() const { return static_cast<int>(entries_.size()); }
   const std::string& indexPath() const { return indexPath_; }
@@ -99,6 +115,14 @@ class FieldSeries {
     long long step = 0;
   };
   std::string xdmf() const;
+  struct Written;
+  /// One grid into frame `entry`: its datasets written into `h5` (a whole grid), or (decomposed)
+  /// reserved there and this rank's rows listed in `pieces` (h5 null on ranks other than 0).
+  void putGrid(Hdf5File* h5, const OutputGrid& g, bool samePoints, bool sameCells, Entry& entry,
+               std::vector<std::pair<std::string, Written>>& pending, std::vector<RowPiece>& pieces) const;
+  void writeShared(const FieldFrame& frame);
+  /// After a frame's file is on disk: take its entry into the index and rewrite the index.
+  void publish(Entry entry, std::vector<std::pair<std::string, Written>>& pending);
 
   /// The last points and cells written of each grid, and where: a frame whose grid has not moved
   /// (or not changed its cells) refers to them instead of writing them again.
@@ -111,6 +135,8 @@ class FieldSeries {
 
   std::string dir_;
   std::string indexPath_;
+  MPI_Comm comm_ = MPI_COMM_NULL;
+  int rank_ = 0, ranks_ = 1;
   std::vector<Entry> entries_;
   std::map<std::string, Written> written_;
 };

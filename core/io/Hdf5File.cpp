@@ -83,9 +83,25 @@ herr_t imageFree(void* image, H5FD_file_image_op_t op, void*) {
   return 0;
 }
 
+/// A closed file's image, unmapped when it goes.
+using ClosedImage = std::unique_ptr<void, void (*)(void*)>;
+
+/// Close `file` (set to -1) and take its image in memory; `closed` says whether HDF5 closed it.
+ClosedImage closeToImage(std::int64_t& file, bool& closed) {
+  void* image = nullptr;
+  committedImage = &image;
+  closed = H5Fclose(file) >= 0;
+  committedImage = nullptr;
+  file = -1;
+  return ClosedImage(image, unmapImage);
+}
+
 void* imageCopy(void* to, const void* from, std::size_t size, H5FD_file_image_op_t, void*) {
   return std::memcpy(to, from, size);
 }
+
+/// A shared file's metadata block (createShared): a frame's groups and dataset headers take a few KiB.
+constexpr std::size_t kSharedMetadataBlock = std::size_t(64) << 10;
 
 /// HDF5 prints its own error stack by default; every call here is checked and reported instead.
 void quietHdf5() {
@@ -136,7 +152,11 @@ void writeDataset(hid_t file, const std::string& path, const std::string& datase
 
 }  // namespace
 
-Hdf5File Hdf5File::create(const std::string& path) {
+Hdf5File Hdf5File::create(const std::string& path) { return createInMemory(path, 0); }
+
+Hdf5File Hdf5File::createShared(const std::string& path) { return createInMemory(path, kSharedMetadataBlock); }
+
+Hdf5File Hdf5File::createInMemory(const std::string& path, std::size_t metadataBlock) {
   quietHdf5();
   Hdf5File f;
   f.path_ = path;
@@ -159,7 +179,8 @@ Hdf5File Hdf5File::create(const std::string& path) {
   memory.image_free = imageFree;
   Handle fapl(H5Pcreate(H5P_FILE_ACCESS), H5Pclose);
   if (fapl.id < 0 || H5Pset_fapl_core(fapl.id, kCoreIncrement, 0) < 0 ||
-      H5Pset_file_image_callbacks(fapl.id, &memory) < 0)
+      H5Pset_file_image_callbacks(fapl.id, &memory) < 0 ||
+      (metadataBlock > 0 && H5Pset_meta_block_size(fapl.id, metadataBlock) < 0))
     throw OutputError("cannot create '" + path + "' (HDF5: the in-memory file driver)");
   f.file_ = H5Fcreate(path.c_str(), H5F_ACC_TRUNC, H5P_DEFAULT, fapl.id);
   if (f.file_ < 0) throw OutputError("cannot create '" + path + "' (HDF5)");
@@ -187,7 +208,8 @@ Hdf5File Hdf5File::openRead(const std::string& path) {
   return f;
 }
 
-Hdf5File::Hdf5File(Hdf5File&& o) noexcept : file_(o.file_), path_(std::move(o.path_)), writing_(std::move(o.writing_)) {
+Hdf5File::Hdf5File(Hdf5File&& o) noexcept
+    : file_(o.file_), path_(std::move(o.path_)), writing_(std::move(o.writing_)), reserved_(std::move(o.reserved_)) {
   o.file_ = -1;
   o.writing_.clear();
 }
@@ -198,6 +220,7 @@ Hdf5File& Hdf5File::operator=(Hdf5File&& o) noexcept {
     file_ = o.file_;
     path_ = std::move(o.path_);
     writing_ = std::move(o.writing_);
+    reserved_ = std::move(o.reserved_);
     o.file_ = -1;
     o.writing_.clear();
   }
@@ -223,6 +246,25 @@ void Hdf5File::write(const std::string& dataset, const std::vector<double>& data
 void Hdf5File::write(const std::string& dataset, const std::vector<std::int64_t>& data,
                      const std::vector<std::size_t>& dims) {
   writeDataset(file_, writing_.empty() ? path_ : writing_, dataset, data, dims, H5T_STD_I64LE, H5T_NATIVE_INT64);
+}
+
+void Hdf5File::reserve(const std::string& dataset, const std::vector<std::size_t>& dims, bool integers) {
+  const std::string& where = writing_.empty() ? path_ : writing_;
+  if (dims.empty() || product(dims) == 0) fail(where, "reserve dataset '" + dataset + "' (no values)");
+  std::vector<hsize_t> hd(dims.begin(), dims.end());
+  Handle space(H5Screate_simple(static_cast<int>(hd.size()), hd.data(), nullptr), H5Sclose);
+  Handle lcpl(H5Pcreate(H5P_LINK_CREATE), H5Pclose);
+  Handle dcpl(H5Pcreate(H5P_DATASET_CREATE), H5Pclose);
+  // Contiguous (the default layout), allocated now (so it has its offset), never filled: its
+  // writers write every byte of it.
+  if (space.id < 0 || lcpl.id < 0 || dcpl.id < 0 || H5Pset_create_intermediate_group(lcpl.id, 1) < 0 ||
+      H5Pset_alloc_time(dcpl.id, H5D_ALLOC_TIME_EARLY) < 0 || H5Pset_fill_time(dcpl.id, H5D_FILL_TIME_NEVER) < 0)
+    fail(where, "describe dataset '" + dataset + "'");
+  Handle dset(H5Dcreate2(file_, dataset.c_str(), integers ? H5T_STD_I64LE : H5T_IEEE_F64LE, space.id, lcpl.id,
+                         dcpl.id, H5P_DEFAULT),
+              H5Dclose);
+  if (dset.id < 0) fail(where, "create dataset '" + dataset + "'");
+  reserved_.push_back(dataset);
 }
 
 void Hdf5File::writeAttribute(const std::string& name, double value) {
@@ -331,18 +373,105 @@ void Hdf5File::commit() {
   // compared over every frame and checkpoint of the test suite when this was written.) Nothing here
   // writes to disk, so nothing fails for a full disk before writeBytesAtomically, which checks.
   const ssize_t size = H5Fflush(file_, H5F_SCOPE_GLOBAL) >= 0 ? H5Fget_file_image(file_, nullptr, 0) : -1;
-  void* image = nullptr;
-  committedImage = &image;
-  const bool closed = H5Fclose(file_) >= 0;
-  committedImage = nullptr;
-  file_ = -1;
-  const std::unique_ptr<void, void (*)(void*)> owned(image, unmapImage);
+  bool closed = false;
+  const ClosedImage owned = closeToImage(file_, closed);
+  void* image = owned.get();
   if (!closed || size <= 0 || image == nullptr) {
     close();
     throw OutputError("cannot finish writing '" + path_ + "' (HDF5: the file's image in memory)");
   }
   writing_.clear();  // writeBytesAtomically removes the temporary file when it fails
   writeBytesAtomically(path_, static_cast<const char*>(image), static_cast<std::size_t>(size));
+}
+
+namespace {
+/// The end of the file as its superblock records it (where HDF5's reader expects the file's last
+/// byte): version 0 and 1 superblocks hold it 40 and 44 bytes in, versions 2 and 3 at 28.
+std::uint64_t recordedEnd(const unsigned char* image, std::size_t size) {
+  static const unsigned char kSignature[8] = {0x89, 'H', 'D', 'F', '\r', '\n', 0x1a, '\n'};
+  if (size < 48 || std::memcmp(image, kSignature, 8) != 0) return 0;
+  const unsigned version = image[8];
+  std::size_t at = 0;
+  if (version == 0 || version == 1) {
+    if (image[13] != 8) return 0;  // 8-byte addresses
+    at = version == 0 ? 40 : 44;
+  } else if (version == 2 || version == 3) {
+    if (image[9] != 8) return 0;
+    at = 28;
+  } else {
+    return 0;
+  }
+  std::uint64_t end = 0;
+  for (int b = 7; b >= 0; --b) end = (end << 8) | image[at + static_cast<std::size_t>(b)];  // little endian
+  return end;
+}
+}  // namespace
+
+std::vector<ReservedDataset> Hdf5File::commitLayout() {
+  if (writing_.empty()) throw OutputError("'" + path_ + "' was not opened for writing");
+  std::vector<ReservedDataset> layout;
+  for (const std::string& name : reserved_) {
+    Handle dset(H5Dopen2(file_, name.c_str(), H5P_DEFAULT), H5Dclose);
+    const haddr_t offset = dset.id >= 0 ? H5Dget_offset(dset.id) : HADDR_UNDEF;
+    if (offset == HADDR_UNDEF) {
+      close();
+      fail(path_, "find the place of dataset '" + name + "'");
+    }
+    layout.push_back({name, static_cast<std::uint64_t>(offset), static_cast<std::uint64_t>(H5Dget_storage_size(dset.id))});
+  }
+  // Closed without a flush first: a flush would zero the whole length of the file in memory,
+  // reserved values and all; closing writes the metadata alone into the image.
+  bool closed = false;
+  const ClosedImage owned = closeToImage(file_, closed);
+  void* image = owned.get();
+  const std::size_t held = image ? mappedBytes(image) - kPage : 0;  // bytes beyond are zero
+  const std::uint64_t end = image ? recordedEnd(static_cast<const unsigned char*>(image), held) : 0;
+  if (!closed || image == nullptr || end == 0) {
+    close();
+    throw OutputError("cannot finish writing '" + path_ + "' (HDF5: the file's image in memory)");
+  }
+  std::vector<ReservedDataset> byOffset = layout;
+  std::sort(byOffset.begin(), byOffset.end(),
+            [](const ReservedDataset& a, const ReservedDataset& b) { return a.offset < b.offset; });
+  std::uint64_t length = end;
+  for (const auto& r : byOffset) length = std::max(length, r.offset + r.bytes);
+  // The image's bytes between the reserved datasets; what lies beyond the image is zeros (a hole).
+  // The file ends where its last byte outside the reserved datasets does (the reserved bytes'
+  // writers extend it over theirs).
+  std::uint64_t tail = 0, at = 0;
+  for (const auto& r : byOffset) {
+    if (r.offset > at) tail = r.offset;
+    at = std::max(at, r.offset + r.bytes);
+  }
+  if (length > at) tail = length;
+  const int fd = ::open(writing_.c_str(), O_WRONLY | O_TRUNC | O_CLOEXEC);
+  int err = fd < 0 ? errno : 0;
+  if (err == 0 && ::ftruncate(fd, static_cast<off_t>(tail)) != 0) err = errno;
+  auto put = [&](std::uint64_t from, std::uint64_t to) {
+    to = std::min<std::uint64_t>(to, held);
+    const char* bytes = static_cast<const char*>(image);
+    while (err == 0 && from < to) {
+      const ssize_t n = ::pwrite(fd, bytes + from, static_cast<std::size_t>(std::min<std::uint64_t>(to - from, 1u << 20)),
+                                 static_cast<off_t>(from));
+      if (n < 0 && errno == EINTR) continue;
+      if (n <= 0) err = n == 0 ? EIO : errno;
+      else from += static_cast<std::uint64_t>(n);
+    }
+  };
+  std::uint64_t cursor = 0;
+  for (const auto& r : byOffset) {
+    put(cursor, r.offset);
+    cursor = std::max(cursor, r.offset + r.bytes);
+  }
+  put(cursor, length);
+  if (fd >= 0 && ::close(fd) != 0 && err == 0) err = errno;
+  if (err != 0) {
+    close();
+    throw OutputError("cannot write '" + path_ + "': " + std::strerror(err) + " (is the disk full?)");
+  }
+  writing_.clear();  // the file's writers rename or remove it
+  reserved_.clear();
+  return layout;
 }
 
 }  // namespace mfsi::io

@@ -457,6 +457,10 @@ void FsiCoupling::addOutputFields(io::FieldFrame& frame) {
   }
 }
 
+bool FsiCoupling::outputReadsWholeMesh() const {
+  return std::any_of(panels_.begin(), panels_.end(), [](const Panel& p) { return p.mounted; });
+}
+
 std::vector<Module*> FsiCoupling::parts() {
   std::vector<Module*> v{fluid_.get()};
   for (auto& m : ownedMembranes_) v.push_back(m.get());
