@@ -73,9 +73,6 @@ class Module {
   /// Add this module's fields to an output frame: a grid of its own (a membrane, the bodies) or
   /// fields on another's (the fluid's U and p on the scene mesh's grid "mesh").
   virtual void addOutputFields(io::FieldFrame& /*frame*/) {}
-  /// True when addOutputFields reads the whole scene mesh's points on rank 0 (a decomposed run then
-  /// gathers them there before a frame; otherwise each rank writes its own part of the mesh).
-  virtual bool outputReadsWholeMesh() const { return false; }
   /// Column names and values of this module in steps.csv.
   virtual std::vector<std::string> stepColumns() const { return {}; }
   virtual void appendStepValues(std::vector<double>& /*values*/) const {}

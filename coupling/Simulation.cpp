@@ -270,12 +270,7 @@ io::FieldFrame Simulation::fieldFrame(double time, long long step) {
   frame.time = time;
   frame.step = step;
   if (hasMesh_ && ranks_ > 1) {
-    // Each rank writes its own part of the mesh (FieldSeries); the whole mesh's points reach rank
-    // 0 only for a module that reads them there.
-    bool gather = false;
-    for (const auto& m : modules_) gather = gather || m->outputReadsWholeMesh();
-    if (gather) gatherPoints();
-    frame.grids.push_back(meshPart());
+    frame.grids.push_back(meshPart());  // each rank writes its own part (FieldSeries)
   } else if (hasMesh_) {
     io::OutputGrid g;
     g.name = "mesh";

@@ -13,6 +13,7 @@
 #include <cmath>
 #include <limits>
 #include <sstream>
+#include <unordered_map>
 
 namespace mfsi {
 
@@ -445,20 +446,36 @@ void FsiCoupling::setUpParents(const SceneConfig& section) {
 }
 
 void FsiCoupling::addOutputFields(io::FieldFrame& frame) {
-  std::vector<double> points;
+  // A mounted panel is written at its fluid nodes (frame and membrane never gap). On several ranks
+  // each rank fills in the nodes it owns and zeros elsewhere, and one sum gives rank 0 every node
+  // exactly (each node has one owner): no rank gathers the mesh.
+  std::vector<double> points;                   // this rank's mesh points, read once
+  std::unordered_map<gid_t, std::size_t> owned;  // whole-mesh node -> this rank's owned node
   for (const Panel& p : panels_) {
-    io::OutputGrid* grid = p.mounted ? frame.find(p.module->name()) : nullptr;
-    if (!grid) continue;
-    // The whole mesh: on several ranks the run gathers its points before a frame.
-    if (points.empty()) points = io::hostValues(whole_.points(), static_cast<std::size_t>(whole_.nNodes()));
-    const std::vector<lid_t>& node = p.module->fluidSurface()->fluidNode;
-    for (std::size_t i = 0; i < node.size(); ++i)
-      for (std::size_t k = 0; k < 3; ++k) grid->points[3 * i + k] = points[3 * static_cast<std::size_t>(node[i]) + k];
+    if (!p.mounted) continue;
+    const std::vector<lid_t>& node = p.module->fluidSurface()->fluidNode;  // whole-mesh nodes
+    if (points.empty()) {
+      points = io::hostValues(mesh_.points(), static_cast<std::size_t>(mesh_.nNodes()));
+      if (comm_ != MPI_COMM_NULL) {
+        auto gid = Kokkos::create_mirror_view_and_copy(HostSpace(), mesh_.nodeGlobalIds());
+        for (lid_t i = 0; i < mesh_.nOwnedNodes(); ++i) owned.emplace(gid(i), static_cast<std::size_t>(i));
+      }
+    }
+    std::vector<double> x(3 * node.size(), 0.0);
+    for (std::size_t i = 0; i < node.size(); ++i) {
+      std::size_t at = static_cast<std::size_t>(node[i]);
+      if (comm_ != MPI_COMM_NULL) {
+        const auto it = owned.find(static_cast<gid_t>(node[i]));
+        if (it == owned.end()) continue;
+        at = it->second;
+      }
+      for (std::size_t k = 0; k < 3; ++k) x[3 * i + k] = points[3 * at + k];
+    }
+    if (comm_ != MPI_COMM_NULL)
+      MPI_Reduce(rank_ == 0 ? MPI_IN_PLACE : x.data(), x.data(), static_cast<int>(x.size()), MPI_DOUBLE, MPI_SUM, 0,
+                 comm_);
+    if (io::OutputGrid* grid = frame.find(p.module->name()); grid && rank_ == 0) grid->points = std::move(x);
   }
-}
-
-bool FsiCoupling::outputReadsWholeMesh() const {
-  return std::any_of(panels_.begin(), panels_.end(), [](const Panel& p) { return p.mounted; });
 }
 
 std::vector<Module*> FsiCoupling::parts() {
@@ -1158,8 +1175,12 @@ void FsiCoupling::loadState(const io::StateReader& r) {
     pr.getView("force", p.force);
     pr.getView("forcePrevious", p.forcePrevious);
     pr.getView("faceVelocity", p.faceVelocity);
-    pr.getView("filtered", p.filtered);
-    p.haveFiltered = pr.boolean("haveFiltered");
+    // A load filter switched on at a restart (--allow-changes) starts afresh, as at a run's start
+    // (its first step unfiltered, then from that step's load); one switched off leaves its state.
+    const std::vector<std::size_t> stored = pr.shape("filtered");
+    const bool filterStored = !stored.empty() && stored[0] > 0;
+    if (p.filtered.extent(0) > 0 && filterStored) pr.getView("filtered", p.filtered);
+    p.haveFiltered = p.filtered.extent(0) > 0 && filterStored && pr.boolean("haveFiltered");
     if (options_.extrapolatedPredictor) {
       pr.getView("loadLastStep", p.loadLastStep);
       p.haveLastStep = pr.boolean("haveLastStep");

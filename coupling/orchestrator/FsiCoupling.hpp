@@ -82,7 +82,6 @@ class FsiCoupling final : public Module {
   /// A mounted membrane's grid (its module wrote it: reference + relative displacement) moved to
   /// where the membrane is: the fluid nodes it carries (its `displacement` stays frame-relative).
   void addOutputFields(io::FieldFrame& frame) override;
-  bool outputReadsWholeMesh() const override;
 
   FluidModule& fluid() { return *fluid_; }
   MembraneModule& membrane(std::size_t i) { return *panels_[i].module; }

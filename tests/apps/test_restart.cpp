@@ -164,6 +164,43 @@ TEST(Restart, AllowedChangesAreListedButNotTheMeshNorTheTimeStep) {
   }
 }
 
+// The membrane load's filter switched on or off at a restart: switched on, it starts as at a
+// run's start (the first step after the restart is the unfiltered run's, bit for bit; the next
+// is filtered); switched off, its state is left behind.
+TEST(Restart, ALoadFilterSwitchedOnOrOffAtARestartStartsAfresh) {
+  const std::vector<std::string> cavity = {"mesh.blocks.0.cells=[12,10,1]", "mesh.blocks.1.cells=[12,2,1]",
+                                           "output.checkpoint.final=true"};
+  const std::string plain = mfsi::test::freshDir("restart_filter_plain");
+  const std::string filtered = mfsi::test::freshDir("restart_filter_filtered");
+  for (const std::string& dir : {plain, filtered}) {
+    const std::string tau = dir == filtered ? "coupling.pNetFilterTau=0.5" : "coupling.pNetFilterTau=0";
+    mfsi::Simulation sim(scene("flexible-cavity", with(cavity, {"time.maxSteps=6", tau})));
+    ASSERT_EQ(sim.run(dir, false).steps, 6);
+  }
+  // The unfiltered run's checkpoint at step 6 is 6 steps in; run 6 .. 8 with the filter on.
+  const std::string on = mfsi::test::freshDir("restart_filter_on");
+  {
+    mfsi::Simulation sim(scene("flexible-cavity", with(cavity, {"time.maxSteps=8", "coupling.pNetFilterTau=0.5"})));
+    ASSERT_NO_THROW(sim.restore(mfsi::Simulation::findCheckpoint(plain), true));
+    ASSERT_EQ(sim.run(on, false).steps, 8);
+  }
+  const std::string off = mfsi::test::freshDir("restart_filter_plain_on");
+  {
+    mfsi::Simulation sim(scene("flexible-cavity", with(cavity, {"time.maxSteps=8", "coupling.pNetFilterTau=0"})));
+    sim.restore(mfsi::Simulation::findCheckpoint(plain), true);
+    ASSERT_EQ(sim.run(off, false).steps, 8);
+  }
+  const auto a = mfsi::test::readSteps(on + "/steps.csv"), b = mfsi::test::readSteps(off + "/steps.csv");
+  const std::string y = "membrane.bottom.centreUy";
+  ASSERT_EQ(a.at(y).size(), 2u);
+  EXPECT_EQ(a.at(y)[0], b.at(y)[0]) << "the first step after switching the filter on is unfiltered";
+  EXPECT_NE(a.at(y)[1], b.at(y)[1]) << "the second is filtered";
+  // And the filtered run's checkpoint continues with the filter off.
+  mfsi::Simulation sim(scene("flexible-cavity", with(cavity, {"time.maxSteps=8", "coupling.pNetFilterTau=0"})));
+  ASSERT_NO_THROW(sim.restore(mfsi::Simulation::findCheckpoint(filtered), true));
+  EXPECT_EQ(sim.run(mfsi::test::freshDir("restart_filter_off"), false).steps, 8);
+}
+
 TEST(Restart, TheMembraneSquaresDynamicsContinueBitwise) {
   expectRestartIsBitwise("membrane_square", "membrane-square", {"membranes.0.mesh.rectangle.cells=[6,6]"}, 6);
 }
