@@ -239,27 +239,32 @@ void Simulation::meshMetrics(std::map<std::string, double>& m) const {
   m["mesh.patches"] = static_cast<double>(mesh_.patches().size());
 }
 
-io::OutputGrid Simulation::meshPart() const {
+io::OutputGrid Simulation::meshGrid() const {
+  // On several ranks this rank's part (its owned points and cells, by global id), else the mesh.
+  const bool decomposed = ranks_ > 1;
+  const HexMesh& m = decomposed ? localMesh_ : mesh_;
   io::OutputGrid g;
   g.name = "mesh";
   g.shape = io::CellShape::Hexahedron;
-  g.decomposed = true;
+  g.decomposed = decomposed;
   g.globalPoints = static_cast<std::size_t>(mesh_.nNodes());
   g.globalCells = static_cast<std::size_t>(mesh_.nCells());
-  const std::size_t nNodes = static_cast<std::size_t>(localMesh_.nOwnedNodes());
-  const std::size_t nCells = static_cast<std::size_t>(localMesh_.nOwnedCells());
-  auto nodeIds = Kokkos::create_mirror_view_and_copy(HostSpace(), localMesh_.nodeGlobalIds());
-  auto cellIds = Kokkos::create_mirror_view_and_copy(HostSpace(), localMesh_.cellGlobalIds());
-  g.pointRows.assign(nodeIds.data(), nodeIds.data() + nNodes);
-  g.cellRows.assign(cellIds.data(), cellIds.data() + nCells);
-  g.points = io::hostValues(localMesh_.points(), nNodes);
-  const std::vector<double> x0 = io::hostValues(localMesh_.referencePoints(), nNodes);
+  const std::size_t nNodes = static_cast<std::size_t>(m.nOwnedNodes());
+  const std::size_t nCells = static_cast<std::size_t>(m.nOwnedCells());
+  auto nodeIds = Kokkos::create_mirror_view_and_copy(HostSpace(), m.nodeGlobalIds());  // the identity on one rank
+  if (decomposed) {
+    auto cellIds = Kokkos::create_mirror_view_and_copy(HostSpace(), m.cellGlobalIds());
+    g.pointRows.assign(nodeIds.data(), nodeIds.data() + nNodes);
+    g.cellRows.assign(cellIds.data(), cellIds.data() + nCells);
+  }
+  g.points = io::hostValues(m.points(), nNodes);
+  const std::vector<double> x0 = io::hostValues(m.referencePoints(), nNodes);
   std::vector<double> d(g.points.size());
   for (std::size_t i = 0; i < d.size(); ++i) d[i] = g.points[i] - x0[i];
-  for (double c : io::hostValues(localMesh_.cellNodes(), nCells))
+  for (double c : io::hostValues(m.cellNodes(), nCells))
     g.cells.push_back(static_cast<std::int64_t>(nodeIds(static_cast<std::size_t>(c))));  // global points
-  RealView quality("mfsi::output::scaledJacobian", static_cast<std::size_t>(localMesh_.nCells()));
-  cellScaledJacobians(ExecSpace(), localMesh_, quality);
+  RealView quality("mfsi::output::scaledJacobian", static_cast<std::size_t>(m.nCells()));
+  cellScaledJacobians(ExecSpace(), m, quality);
   g.addPointField("meshDisplacement", 3, std::move(d), true, true);
   g.addCellField("scaledJacobian", 1, io::hostValues(quality, nCells), true, true);
   return g;
@@ -269,25 +274,7 @@ io::FieldFrame Simulation::fieldFrame(double time, long long step) {
   io::FieldFrame frame;
   frame.time = time;
   frame.step = step;
-  if (hasMesh_ && ranks_ > 1) {
-    frame.grids.push_back(meshPart());  // each rank writes its own part (FieldSeries)
-  } else if (hasMesh_) {
-    io::OutputGrid g;
-    g.name = "mesh";
-    g.shape = io::CellShape::Hexahedron;
-    const std::size_t nNodes = static_cast<std::size_t>(mesh_.nNodes());
-    const std::size_t nCells = static_cast<std::size_t>(mesh_.nCells());
-    g.points = io::hostValues(mesh_.points(), nNodes);
-    const std::vector<double> x0 = io::hostValues(mesh_.referencePoints(), nNodes);
-    std::vector<double> d(g.points.size());
-    for (std::size_t i = 0; i < d.size(); ++i) d[i] = g.points[i] - x0[i];
-    for (double c : io::hostValues(mesh_.cellNodes(), nCells)) g.cells.push_back(static_cast<std::int64_t>(c));
-    RealView quality("mfsi::output::scaledJacobian", nCells);
-    cellScaledJacobians(ExecSpace(), mesh_, quality);
-    g.addPointField("meshDisplacement", 3, std::move(d), true, true);
-    g.addCellField("scaledJacobian", 1, io::hostValues(quality, nCells), true, true);
-    frame.grids.push_back(std::move(g));
-  }
+  if (hasMesh_) frame.grids.push_back(meshGrid());  // on several ranks each writes its own part
   // Parts first, then the module that owns them (the coupling moves a mounted membrane's grid to
   // where its frames carry it).
   for (auto& m : modules_) {

@@ -122,8 +122,8 @@ class Simulation {
   /// The state now, as one output frame: the scene mesh's grid "mesh" (positions, displacement
   /// from the reference mesh, each cell's scaled Jacobian) and every module's fields.
   io::FieldFrame fieldFrame(double time, long long step);
-  /// This rank's part of the scene mesh's grid (a decomposed run): its owned points and cells.
-  io::OutputGrid meshPart() const;
+  /// The scene mesh's grid of a frame; on several ranks this rank's part (its owned points and cells).
+  io::OutputGrid meshGrid() const;
 
   /// Build this rank's part of mesh_ (METIS over the ranks, each membrane's cells on one rank);
   /// throws InputError for what does not run on several ranks yet.

@@ -166,11 +166,19 @@ void makeFieldsFolder(const std::string& dir) {
 }
 }  // namespace
 
-void FieldSeries::putGrid(Hdf5File* h5, const OutputGrid& g, bool samePoints, bool sameCells, Entry& entry,
+std::pair<bool, bool> FieldSeries::unchanged(const OutputGrid& g, const std::vector<std::int64_t>& topology) const {
+  const auto known = written_.find(g.name);
+  if (known == written_.end()) return {false, false};
+  return {known->second.points == g.points, known->second.topology == topology};
+}
+
+void FieldSeries::putGrid(Hdf5File* h5, const OutputGrid& g, const std::pair<bool, bool>* agreed, Entry& entry,
                           std::vector<std::pair<std::string, Written>>& pending, std::vector<RowPiece>& pieces) const {
   if (g.decomposed && g.shape != CellShape::Hexahedron)
     throw std::logic_error("output grid '" + g.name + "': only a hexahedral grid may be decomposed");
   Topology topo = topologyOf(g);
+  const std::pair<bool, bool> same = agreed ? *agreed : unchanged(g, topo.values);
+  const bool samePoints = same.first, sameCells = same.second;  // (a lambda below reads them)
   const std::size_t nPoints = g.decomposed ? g.globalPoints : g.nPoints();
   const std::size_t nCells = g.decomposed ? g.globalCells : g.nCells();
   if (g.decomposed) topo.dims = {nCells, 8};
@@ -255,10 +263,7 @@ void FieldSeries::write(const FieldFrame& frame) {
   std::vector<RowPiece> pieces;
   for (const OutputGrid& g : frame.grids) {
     if (g.decomposed) throw std::logic_error("output grid '" + g.name + "' is decomposed on a one-rank series");
-    const auto known = written_.find(g.name);
-    const bool samePoints = known != written_.end() && known->second.points == g.points;
-    const bool sameCells = known != written_.end() && known->second.topology == topologyOf(g).values;
-    putGrid(&h5, g, samePoints, sameCells, entry, pending, pieces);
+    putGrid(&h5, g, nullptr, entry, pending, pieces);
   }
   h5.commit();
   publish(std::move(entry), pending);
@@ -273,9 +278,9 @@ void FieldSeries::writeShared(const FieldFrame& frame) {
   std::vector<int> same(2 * parts.size() + 1);
   same.back() = static_cast<int>(parts.size());
   for (std::size_t i = 0; i < parts.size(); ++i) {
-    const auto known = written_.find(parts[i]->name);
-    same[2 * i] = known != written_.end() && known->second.points == parts[i]->points;
-    same[2 * i + 1] = known != written_.end() && known->second.topology == parts[i]->cells;
+    const auto [points, cells] = unchanged(*parts[i], parts[i]->cells);  // a hexahedral grid's topology is its cells
+    same[2 * i] = points;
+    same[2 * i + 1] = cells;
   }
   std::vector<int> low(same.size()), high(same.size());
   MPI_Allreduce(same.data(), low.data(), static_cast<int>(same.size()), MPI_INT, MPI_MIN, comm_);
@@ -298,16 +303,13 @@ void FieldSeries::writeShared(const FieldFrame& frame) {
       h5.emplace(Hdf5File::createShared(path));
       h5->writeAttribute("time", frame.time);
       h5->writeAttribute("step", static_cast<double>(frame.step));
-      for (const OutputGrid& g : frame.grids) {
-        if (g.decomposed) continue;
-        const auto known = written_.find(g.name);
-        const bool samePoints = known != written_.end() && known->second.points == g.points;
-        const bool sameCells = known != written_.end() && known->second.topology == topologyOf(g).values;
-        putGrid(&*h5, g, samePoints, sameCells, entry, pending, pieces);
-      }
+      for (const OutputGrid& g : frame.grids)
+        if (!g.decomposed) putGrid(&*h5, g, nullptr, entry, pending, pieces);
     }
-    for (std::size_t i = 0; i < parts.size(); ++i)
-      putGrid(h5 ? &*h5 : nullptr, *parts[i], low[2 * i] != 0, low[2 * i + 1] != 0, entry, pending, pieces);
+    for (std::size_t i = 0; i < parts.size(); ++i) {
+      const std::pair<bool, bool> agreed{low[2 * i] != 0, low[2 * i + 1] != 0};
+      putGrid(h5 ? &*h5 : nullptr, *parts[i], &agreed, entry, pending, pieces);
+    }
     if (h5) layout = h5->commitLayout();
     // The index lists the grids in the frame's order, as on one rank (the whole grids were
     // written first, so that their values lie before the reserved ones).
@@ -362,14 +364,7 @@ void FieldSeries::writeShared(const FieldFrame& frame) {
   if (!ok) throw OutputError(rows.empty() ? fromRankZero(comm_, published) : rows);
   if (rank_ != 0) {
     entries_.push_back(Entry{frame.time, entry.file, {}, frame.step});
-    for (auto& [name, next] : pending) {
-      Written& w = written_[name];
-      if (next.pointsFile == entry.file) w.points = std::move(next.points);
-      if (next.topologyFile == entry.file) w.topology = std::move(next.topology);
-      w.pointsFile = next.pointsFile;
-      w.topologyFile = next.topologyFile;
-      w.geometricFiles = std::move(next.geometricFiles);
-    }
+    remember(pending, entry.file);
   }
 }
 
@@ -384,7 +379,10 @@ void FieldSeries::publish(Entry entry, std::vector<std::pair<std::string, Writte
     entries_.pop_back();
     throw;
   }
-  const std::string& file = entries_.back().file;
+  remember(pending, entries_.back().file);
+}
+
+void FieldSeries::remember(std::vector<std::pair<std::string, Written>>& pending, const std::string& file) {
   for (auto& [name, next] : pending) {
     Written& w = written_[name];
     if (next.pointsFile == file) w.points = std::move(next.points);

@@ -13,6 +13,7 @@
 #include <cstdint>
 #include <map>
 #include <string>
+#include <utility>
 #include <vector>
 
 namespace mfsi::io {
@@ -116,13 +117,19 @@ class FieldSeries {
   };
   std::string xdmf() const;
   struct Written;
+  /// Whether this rank's grid `g` has the points and the topology written last (not yet: false).
+  std::pair<bool, bool> unchanged(const OutputGrid& g, const std::vector<std::int64_t>& topology) const;
   /// One grid into frame `entry`: its datasets written into `h5` (a whole grid), or (decomposed)
   /// reserved there and this rank's rows listed in `pieces` (h5 null on ranks other than 0).
-  void putGrid(Hdf5File* h5, const OutputGrid& g, bool samePoints, bool sameCells, Entry& entry,
+  /// Unchanged points and topology are referred to where they were written: `agreed` (the ranks'
+  /// verdict on a decomposed grid), or null to decide from this rank's grid.
+  void putGrid(Hdf5File* h5, const OutputGrid& g, const std::pair<bool, bool>* agreed, Entry& entry,
                std::vector<std::pair<std::string, Written>>& pending, std::vector<RowPiece>& pieces) const;
   void writeShared(const FieldFrame& frame);
   /// After a frame's file is on disk: take its entry into the index and rewrite the index.
   void publish(Entry entry, std::vector<std::pair<std::string, Written>>& pending);
+  /// Keep where this frame's grids are (`file`: the frame's own file) for the next frame.
+  void remember(std::vector<std::pair<std::string, Written>>& pending, const std::string& file);
 
   /// The last points and cells written of each grid, and where: a frame whose grid has not moved
   /// (or not changed its cells) refers to them instead of writing them again.
