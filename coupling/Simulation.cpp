@@ -440,8 +440,7 @@ std::string Simulation::writeCheckpoint(const std::string& outDir, const TimeSta
   char name[64];
   std::snprintf(name, sizeof name, "%s%09lld.h5", kCheckpointPrefix, static_cast<long long>(ts.step));
   const std::string path = (dir / name).string();
-  gatherPoints();  // several ranks: the whole mesh's points on rank 0
-  // Every rank writes its file; rank 0 commits its own only when all others have committed theirs.
+  // Every rank writes its file (its part's points and state, no gather); rank 0 commits its own only when all others have committed theirs.
   std::string failure;
   std::optional<io::Hdf5File> file;
   try {
@@ -461,10 +460,10 @@ std::string Simulation::writeCheckpoint(const std::string& outDir, const TimeSta
       run.putInt("firstStep", firstStep_);
       run.putText("fields", fields.state());
       run.putInt("partition", partitionHash_);
-      if (hasMesh_) {
-        io::StateWriter mesh(*file, "/mesh");
-        mesh.putView("points", mesh_.points());
-      }
+    }
+    if (hasMesh_) {  // the moved points of the mesh this rank computes on, by node (carried by global id)
+      io::StateWriter mesh(*file, "/mesh");
+      mesh.putView("points", (ranks_ > 1 ? localMesh_ : mesh_).points(), io::Entity::Nodes);
     }
     if (ranks_ > 1 && hasMesh_) {  // what carries the state to another decomposition (restore)
       if (!partIds_) partIds_ = io::partIds(localMesh_, mesh_);
@@ -571,6 +570,23 @@ io::Hdf5File Simulation::carryCheckpoint(const io::Hdf5File& first, const std::s
   return carried;
 }
 
+void Simulation::restorePoints(const io::Hdf5File& first, const io::Hdf5File& states) {
+  HexMesh& m = ranks_ > 1 ? localMesh_ : mesh_;
+  if (first.has(io::entityTagPath("/mesh/points"))) {  // each rank's file has its part's points
+    io::StateReader(states, "/mesh").getView("points", m.points());
+    return;
+  }
+  // A checkpoint written before its parts held their points: rank 0's file has the whole mesh's.
+  io::StateReader(first, "/mesh").getView("points", mesh_.points());
+  if (ranks_ == 1) return;
+  auto whole = Kokkos::create_mirror_view_and_copy(HostSpace(), mesh_.points());
+  auto gid = Kokkos::create_mirror_view_and_copy(HostSpace(), localMesh_.nodeGlobalIds());
+  auto x = Kokkos::create_mirror_view(localMesh_.points());
+  for (lid_t i = 0; i < localMesh_.nNodes(); ++i)
+    for (int c = 0; c < 3; ++c) x(i, c) = whole(gid(i), c);
+  Kokkos::deep_copy(localMesh_.points(), x);
+}
+
 std::vector<std::string> Simulation::restore(const std::string& checkpointFile, bool allowChanges) {
   ScopedTimer timer(timers_, "restore");
   io::Hdf5File file = [&] {
@@ -615,18 +631,6 @@ std::vector<std::string> Simulation::restore(const std::string& checkpointFile, 
     throw InputError("--restart: the checkpoint is at step " + std::to_string(st.time.step) + " (t = " +
                      formatReal(st.time.time) + "), beyond the scene's end (" + std::to_string(nSteps_) +
                      " steps): raise time.endTime to continue");
-  if (hasMesh_) {
-    io::StateReader mesh(file, "/mesh");
-    mesh.getView("points", mesh_.points());
-    if (ranks_ > 1) {  // this rank's part: its nodes' points by global id
-      auto whole = Kokkos::create_mirror_view_and_copy(HostSpace(), mesh_.points());
-      auto gid = Kokkos::create_mirror_view_and_copy(HostSpace(), localMesh_.nodeGlobalIds());
-      auto x = Kokkos::create_mirror_view(localMesh_.points());
-      for (lid_t i = 0; i < localMesh_.nNodes(); ++i)
-        for (int c = 0; c < 3; ++c) x(i, c) = whole(gid(i), c);
-      Kokkos::deep_copy(localMesh_.points(), x);
-    }
-  }
   // Several ranks: each rank's modules from its own file; another decomposition: from a file in
   // memory that this rank's part of the state is carried into from every part of the old one.
   std::optional<io::Hdf5File> own;
@@ -642,6 +646,7 @@ std::vector<std::string> Simulation::restore(const std::string& checkpointFile, 
     }
   }
   const io::Hdf5File& states = own ? *own : file;
+  if (hasMesh_) restorePoints(file, states);
   // Parts first, then the module that owns them (the coupling places its mounted membranes by
   // the bodies' state).
   for (auto& m : modules_) {

@@ -130,6 +130,9 @@ class Simulation {
   void decompose(const SceneConfig& scene, const std::string& partitionFile);
   /// Several ranks: the points of mesh_ on rank 0 <- the parts' moved points (collective).
   void gatherPoints();
+  /// The moved points from a checkpoint: `first` is rank 0's file, `states` this rank's part of
+  /// the state (its own file, or one carried from another decomposition).
+  void restorePoints(const io::Hdf5File& first, const io::Hdf5File& states);
 
   Timers timers_;
   bool hasMesh_ = false;

@@ -242,7 +242,8 @@ void redistribute(const std::vector<const Hdf5File*>& parts, const std::vector<P
   MFSI_CHECK(!parts.empty() && parts.size() == old.size(),
              "redistribute: " << parts.size() << " files for " << old.size() << " parts");
   for (const std::string& d : parts[0]->datasets()) {
-    if (d.rfind("/modules/", 0) != 0) continue;
+    const bool carried = d.rfind("/modules/", 0) == 0 || (d.rfind("/mesh/", 0) == 0 && parts[0]->has(entityTagPath(d)));
+    if (!carried) continue;
     for (const Hdf5File* p : parts)
       if (!p->has(d)) throw InputError(where(*p, d) + ": missing (rank 0's file has it)");
     const std::string tag = entityTagPath(d);

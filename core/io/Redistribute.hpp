@@ -48,7 +48,8 @@ PartIds wholeMeshIds(const HexMesh& global);
 void writePartIds(StateWriter& w, const PartIds& ids);
 PartIds readPartIds(const StateReader& r, const HexMesh& global);
 
-/// \brief Build in `out` every dataset under "/modules" of the part `mine` from the checkpoint in
+/// \brief Build in `out` every dataset under "/modules", and every tagged one under "/mesh" (the
+/// moved points), of the part `mine` from the checkpoint in
 /// `parts` (the old run's files, rank order) with their ids `old`. Throws InputError naming the
 /// file and dataset when the files do not fit together (a missing dataset, a row count that is not
 /// the part's, an untagged value that differs between ranks).
