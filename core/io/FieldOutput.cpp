@@ -295,6 +295,7 @@ void FieldSeries::writeShared(const FieldFrame& frame) {
   // Rank 0 lays the file out (its whole grids written, the decomposed ones reserved); the others
   // list their rows of the same datasets in the same order.
   std::string failure;
+  int fault = 0;
   std::vector<ReservedDataset> layout;
   try {
     std::optional<Hdf5File> h5;
@@ -323,21 +324,35 @@ void FieldSeries::writeShared(const FieldFrame& frame) {
     });
   } catch (const OutputError& e) {
     failure = e.what();
+  } catch (const std::exception& e) {  // a fault on one rank stops every rank with it, not a hang
+    failure = e.what();
+    fault = 1;
+  }
+  // Rank 0's count of reserved datasets, then every rank's verdict: the failure of the lowest
+  // rank that failed, on every rank, a fault (not a write that failed) as a logic_error.
+  constexpr std::uint64_t kFailed = ~std::uint64_t(0);
+  std::uint64_t laidOut = failure.empty() ? layout.size() : kFailed;
+  MPI_Bcast(&laidOut, 1, MPI_UINT64_T, 0, comm_);
+  if (failure.empty() && laidOut != kFailed && laidOut != pieces.size()) {
+    failure = "field output: rank 0 laid out " + std::to_string(laidOut) + " datasets, rank " +
+              std::to_string(rank_) + " has " + std::to_string(pieces.size());
+    fault = 1;
+  }
+  MPI_Allreduce(MPI_IN_PLACE, &fault, 1, MPI_INT, MPI_MAX, comm_);
+  const std::string verdict = agreeOnFailure(comm_, failure);
+  if (!verdict.empty()) {
+    std::error_code ec;
+    if (rank_ == 0) fs::remove(path + ".part", ec);  // laid out for rows that will not come
+    if (fault) throw std::logic_error(verdict);
+    throw OutputError(verdict);
   }
   // Where each reserved dataset lies, from rank 0.
-  std::vector<std::uint64_t> offsets(layout.size() + 1);
-  offsets[0] = failure.empty() ? layout.size() : std::uint64_t(-1);
-  for (std::size_t i = 0; i < layout.size(); ++i) offsets[i + 1] = layout[i].offset;
-  MPI_Bcast(offsets.data(), 1, MPI_UINT64_T, 0, comm_);
-  if (offsets[0] == std::uint64_t(-1)) throw OutputError(fromRankZero(comm_, failure));
-  if (offsets[0] != pieces.size())
-    throw std::logic_error("field output: rank 0 laid out " + std::to_string(offsets[0]) + " datasets, this rank has " +
-                           std::to_string(pieces.size()));
-  offsets.resize(pieces.size() + 1);
-  MPI_Bcast(offsets.data() + 1, static_cast<int>(pieces.size()), MPI_UINT64_T, 0, comm_);
-  for (std::size_t i = 0; i < pieces.size(); ++i) pieces[i].offset = offsets[i + 1];
+  std::vector<std::uint64_t> offsets(pieces.size());
+  for (std::size_t i = 0; i < layout.size(); ++i) offsets[i] = layout[i].offset;
+  MPI_Bcast(offsets.data(), static_cast<int>(offsets.size()), MPI_UINT64_T, 0, comm_);
+  for (std::size_t i = 0; i < pieces.size(); ++i) pieces[i].offset = offsets[i];
   const std::string part = path + ".part";
-  const std::string rows = writeRows(comm_, part, pieces);
+  const std::string rows = writeRows(comm_, part, pieces, path);
   // Rank 0 names the file and lists it; the other ranks keep their parts' points and cells.
   std::string published = rows;
   if (rank_ == 0) {

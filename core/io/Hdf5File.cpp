@@ -240,16 +240,16 @@ void Hdf5File::close() noexcept {
 }
 
 void Hdf5File::write(const std::string& dataset, const std::vector<double>& data, const std::vector<std::size_t>& dims) {
-  writeDataset(file_, writing_.empty() ? path_ : writing_, dataset, data, dims, H5T_IEEE_F64LE, H5T_NATIVE_DOUBLE);
+  writeDataset(file_, path_, dataset, data, dims, H5T_IEEE_F64LE, H5T_NATIVE_DOUBLE);  // messages name the file
 }
 
 void Hdf5File::write(const std::string& dataset, const std::vector<std::int64_t>& data,
                      const std::vector<std::size_t>& dims) {
-  writeDataset(file_, writing_.empty() ? path_ : writing_, dataset, data, dims, H5T_STD_I64LE, H5T_NATIVE_INT64);
+  writeDataset(file_, path_, dataset, data, dims, H5T_STD_I64LE, H5T_NATIVE_INT64);
 }
 
 void Hdf5File::reserve(const std::string& dataset, const std::vector<std::size_t>& dims, bool integers) {
-  const std::string& where = writing_.empty() ? path_ : writing_;
+  const std::string& where = path_;
   if (dims.empty() || product(dims) == 0) fail(where, "reserve dataset '" + dataset + "' (no values)");
   std::vector<hsize_t> hd(dims.begin(), dims.end());
   Handle space(H5Screate_simple(static_cast<int>(hd.size()), hd.data(), nullptr), H5Sclose);

@@ -23,8 +23,9 @@ std::string mpiWriteFailure(const std::string& path, const char* what, int rc) {
          ") (is the disk full?)";
 }
 
-/// Every rank's verdict: "" when all succeeded, else the lowest failed rank's message.
-std::string agreeOnRows(MPI_Comm comm, const std::string& mine) {
+}  // namespace
+
+std::string agreeOnFailure(MPI_Comm comm, const std::string& mine) {
   int rank = 0, size = 1;
   MPI_Comm_rank(comm, &rank);
   MPI_Comm_size(comm, &size);
@@ -37,9 +38,9 @@ std::string agreeOnRows(MPI_Comm comm, const std::string& mine) {
   return text;
 }
 
-}  // namespace
-
-std::string writeRows(MPI_Comm comm, const std::string& path, const std::vector<RowPiece>& pieces) {
+std::string writeRows(MPI_Comm comm, const std::string& path, const std::vector<RowPiece>& pieces,
+                      const std::string& shownAs) {
+  const std::string& name = shownAs.empty() ? path : shownAs;  // what the messages call the file
   // The runs of consecutive rows, in the file's order (a file view must not go backwards).
   std::vector<RowRun> blocks;
   for (const RowPiece& p : pieces) {
@@ -78,18 +79,18 @@ std::string writeRows(MPI_Comm comm, const std::string& path, const std::vector<
   }
   std::string failure;
   if (total > static_cast<std::uint64_t>(INT_MAX) || lengths.size() > static_cast<std::size_t>(INT_MAX))
-    failure = "cannot write '" + path + "': this rank's part of it (" + std::to_string(8 * total) +
+    failure = "cannot write '" + name + "': this rank's part of it (" + std::to_string(8 * total) +
               " bytes) is larger than one MPI-IO call writes (16 GiB)";
   // Each collective call is made on every rank; a rank that failed before it takes part with
   // nothing to write, and the verdict is agreed at the end.
   MPI_File fh = MPI_FILE_NULL;
   int rc = MPI_File_open(comm, path.c_str(), MPI_MODE_WRONLY, MPI_INFO_NULL, &fh);
-  if (rc != MPI_SUCCESS && failure.empty()) failure = mpiWriteFailure(path, "open", rc);
-  const std::string opened = agreeOnRows(comm, rc == MPI_SUCCESS ? "" : "x");
+  if (rc != MPI_SUCCESS && failure.empty()) failure = mpiWriteFailure(name, "open", rc);
+  const std::string opened = agreeOnFailure(comm, rc == MPI_SUCCESS ? "" : "x");
   if (!opened.empty()) {
     if (fh != MPI_FILE_NULL) MPI_File_close(&fh);
-    const std::string verdict = agreeOnRows(comm, failure);
-    return verdict.empty() ? "cannot open '" + path + "' on every rank (MPI-IO)" : verdict;
+    const std::string verdict = agreeOnFailure(comm, failure);
+    return verdict.empty() ? "cannot open '" + name + "' on every rank (MPI-IO)" : verdict;
   }
   MPI_Datatype word = MPI_DATATYPE_NULL, view = MPI_DATATYPE_NULL;
   MPI_Type_contiguous(8, MPI_BYTE, &word);
@@ -100,25 +101,25 @@ std::string writeRows(MPI_Comm comm, const std::string& path, const std::vector<
     MPI_Type_commit(&view);
   }
   rc = MPI_File_set_view(fh, 0, word, writes ? view : word, "native", MPI_INFO_NULL);
-  if (rc != MPI_SUCCESS && failure.empty()) failure = mpiWriteFailure(path, "set_view", rc);
+  if (rc != MPI_SUCCESS && failure.empty()) failure = mpiWriteFailure(name, "set_view", rc);
   MPI_Status status;
   const int count = writes && rc == MPI_SUCCESS ? static_cast<int>(total) : 0;
   // Independent writes: Open MPI's collective writes (ompio's two-phase aggregation) report
   // success and the full count when their aggregator's write failed (a full disk, EFBIG); its
   // independent writes report the short count.
   rc = count > 0 ? MPI_File_write(fh, buffer.data(), count, word, &status) : MPI_SUCCESS;
-  if (rc != MPI_SUCCESS && failure.empty()) failure = mpiWriteFailure(path, "write", rc);
+  if (rc != MPI_SUCCESS && failure.empty()) failure = mpiWriteFailure(name, "write", rc);
   if (rc == MPI_SUCCESS && failure.empty() && count > 0) {
     int written = 0;
     MPI_Get_count(&status, word, &written);
-    if (written != count) failure = "cannot write '" + path + "': " + std::to_string(written) + " of " +
+    if (written != count) failure = "cannot write '" + name + "': " + std::to_string(written) + " of " +
                                     std::to_string(count) + " values written (is the disk full?)";
   }
   rc = MPI_File_close(&fh);
-  if (rc != MPI_SUCCESS && failure.empty()) failure = mpiWriteFailure(path, "close", rc);
+  if (rc != MPI_SUCCESS && failure.empty()) failure = mpiWriteFailure(name, "close", rc);
   if (view != MPI_DATATYPE_NULL) MPI_Type_free(&view);
   MPI_Type_free(&word);
-  return agreeOnRows(comm, failure);
+  return agreeOnFailure(comm, failure);
 }
 
 }  // namespace mfsi::io

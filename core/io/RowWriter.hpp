@@ -28,9 +28,16 @@ struct RowPiece {
   const void* values = nullptr;
 };
 
+/// \brief Every rank's verdict on a step that each rank may fail with a message (`mine`, "" for
+/// success). Collective over `comm`: "" on every rank when all succeeded, else on every rank the
+/// message of the lowest rank that failed.
+std::string agreeOnFailure(MPI_Comm comm, const std::string& mine);
+
 /// \brief Write every rank's pieces into the existing file `path`. Collective over `comm`: returns
 /// "" on every rank when every rank wrote all of its rows, else on every rank the message of the
-/// lowest rank that could not (naming the file, and asking whether the disk is full).
-std::string writeRows(MPI_Comm comm, const std::string& path, const std::vector<RowPiece>& pieces);
+/// lowest rank that could not (naming the file, or `shownAs` when given: the name the file is
+/// published under, and asking whether the disk is full).
+std::string writeRows(MPI_Comm comm, const std::string& path, const std::vector<RowPiece>& pieces,
+                      const std::string& shownAs = {});
 
 }  // namespace mfsi::io

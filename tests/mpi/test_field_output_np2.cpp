@@ -1,7 +1,8 @@
 // Field output of a decomposed grid on 2 ranks: each rank writes its own rows of one shared HDF5
 // file (no gather). The frames and the index are those a one-rank series writes of the whole grid,
 // dataset by dataset bitwise; a frame whose points did not move refers to the earlier file as on
-// one rank; a disk that fills on either rank fails the frame on both, with one message and no file.
+// one rank; a disk that fills on either rank fails the frame on both, with one message and no file,
+// and so does a fault (a malformed grid) on one rank alone, instead of leaving the other waiting.
 #include "core/Error.hpp"
 #include "core/io/FieldOutput.hpp"
 #include "core/io/Hdf5File.hpp"
@@ -181,6 +182,7 @@ TEST(FieldOutputNp2, AFullDiskOnEitherRankFailsTheFrameOnBoth) {
     writeUnderLimit(series, frame(2, 0.5, rank()), limit, error);
     EXPECT_NE(error.find("fields_000002.h5"), std::string::npos) << "rank " << rank() << ": " << error;
     EXPECT_NE(error.find("is the disk full?"), std::string::npos) << "rank " << rank() << ": " << error;
+    EXPECT_EQ(error.find(".part"), std::string::npos) << "names the file it is published as: " << error;
     MPI_Barrier(MPI_COMM_WORLD);
     if (rank() == 0) {
       EXPECT_FALSE(fs::exists(dir + "/fields/fields_000002.h5")) << "limit case " << full;
@@ -195,4 +197,36 @@ TEST(FieldOutputNp2, AFullDiskOnEitherRankFailsTheFrameOnBoth) {
   if (rank() == 0) {
     EXPECT_TRUE(fs::exists(dir + "/fields/fields_000002.h5"));
   }
+}
+
+TEST(FieldOutputNp2, AFaultOnOneRankAloneStopsTheFrameOnBoth) {
+  const std::string dir = sharedDir("fault");
+  FieldSeries series(dir, MPI_COMM_WORLD);
+  series.write(frame(1, 0.0, rank()));
+  // A field of the wrong size: in the surface grid that rank 0 alone writes, then in rank 1's
+  // part of the mesh. Each is found by that rank alone, while rank 0 lays the file out.
+  for (int faulty : {0, 1}) {
+    FieldFrame f = frame(2, 0.5, rank());
+    if (rank() == faulty) {
+      auto& grid = f.grids[faulty == 0 ? 1 : 0];
+      grid.pointFields[0].values.pop_back();
+    }
+    std::string error;
+    try {
+      series.write(f);
+    } catch (const std::exception& e) {  // an OutputError from rank 0's layout, a logic_error from rank 1's rows
+      error = e.what();
+    }
+    const std::string field = faulty == 0 ? "/membrane/point/displacement" : "meshDisplacement";
+    EXPECT_NE(error.find(field), std::string::npos) << "rank " << rank() << ", fault on rank " << faulty << ": " << error;
+    EXPECT_EQ(error.find(".part"), std::string::npos) << "names the file it is published as: " << error;
+    MPI_Barrier(MPI_COMM_WORLD);
+    if (rank() == 0) {
+      EXPECT_FALSE(fs::exists(dir + "/fields/fields_000002.h5")) << "fault on rank " << faulty;
+      EXPECT_FALSE(fs::exists(dir + "/fields/fields_000002.h5.part")) << "fault on rank " << faulty;
+    }
+    EXPECT_EQ(series.frames(), 1);
+  }
+  series.write(frame(2, 0.5, rank()));
+  EXPECT_EQ(series.frames(), 2);
 }
