@@ -89,7 +89,7 @@ MeshQuality computeQuality(const ExecSpace& exec, const HexMesh& mesh, const Mes
   MeshQuality q;
   q.minScaledJacobian = minScaledJacobian(exec, mesh);
   Kokkos::parallel_reduce(
-      "mfsi::core::quality::cells", RangePolicy(exec, 0, mesh.nCells()),
+      "mfsi::core::quality::cells", RangePolicy(exec, 0, mesh.nOwnedCells()),
       KOKKOS_LAMBDA(lid_t c, double& vsum, double& vmin, double& vmax) {
         vsum += vol(c);
         vmin = vol(c) < vmin ? vol(c) : vmin;
@@ -102,12 +102,19 @@ MeshQuality computeQuality(const ExecSpace& exec, const HexMesh& mesh, const Mes
   ConstReal3View cc = geo.cellCentroid;
   ConstReal3View sf = geo.faceArea;
   ConstReal3View fc = geo.faceCentroid;
+  const auto gid = mesh.cellGlobalIds();
+  const lid_t nOwned = mesh.nOwnedCells();
   double sumAngle = 0.0;
+  long long counted = 0;
   const lid_t nIn = mesh.nInternalFaces();
   Kokkos::parallel_reduce(
       "mfsi::core::quality::faces", RangePolicy(exec, 0, nIn),
-      KOKKOS_LAMBDA(lid_t f, double& amax, double& asum, double& smax) {
+      KOKKOS_LAMBDA(lid_t f, double& amax, double& asum, double& smax, long long& count) {
         const lid_t o = own(f), n = nei(f);
+        // Each face once over the ranks: by the rank that owns its cell of the lower global id.
+        const lid_t first = gid(o) < gid(n) ? o : n;
+        if (first >= nOwned) return;
+        ++count;
         double d[3], s[3];
         for (int k = 0; k < 3; ++k) {
           d[k] = cc(n, k) - cc(o, k);
@@ -128,9 +135,10 @@ MeshQuality computeQuality(const ExecSpace& exec, const HexMesh& mesh, const Mes
         const double sk = geom::norm(e) / dn;
         smax = sk > smax ? sk : smax;
       },
-      Kokkos::Max<double>(q.maxNonOrthogonality), sumAngle, Kokkos::Max<double>(q.maxSkewness));
-  q.meanNonOrthogonality = nIn > 0 ? sumAngle / nIn : 0.0;
-  if (nIn == 0) {
+      Kokkos::Max<double>(q.maxNonOrthogonality), sumAngle, Kokkos::Max<double>(q.maxSkewness), counted);
+  q.countedFaces = counted;
+  q.meanNonOrthogonality = counted > 0 ? sumAngle / static_cast<double>(counted) : 0.0;
+  if (counted == 0) {
     q.maxNonOrthogonality = 0.0;
     q.maxSkewness = 0.0;
   }

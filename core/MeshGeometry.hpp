@@ -21,11 +21,14 @@ MeshGeometry allocateGeometry(const HexMesh& mesh);
 /// Compute all geometry of `mesh` at its current points into `geo` (no fence at the end).
 void computeGeometry(const ExecSpace& exec, const HexMesh& mesh, const MeshGeometry& geo);
 
-/// \brief Mesh quality summary (reductions over cells and internal faces).
+/// \brief Mesh quality summary (reductions over cells and internal faces). On a rank's part of a
+/// mesh the sums count what the rank owns: its owned cells, and each internal face once over all
+/// ranks (a face between an owned and a ghost cell on the rank of the lower global cell id).
 struct MeshQuality {
   double minScaledJacobian = 0;  ///< over all cell corners; 1 = cube, <= 0 inverted
   double maxNonOrthogonality = 0;  ///< degrees, angle between owner->neighbour and face normal
   double meanNonOrthogonality = 0;  ///< degrees, over internal faces
+  long long countedFaces = 0;  ///< the internal faces the mean is over
   double maxSkewness = 0;  ///< OpenFOAM-style: |face centroid - intersection| / |owner->neighbour|
   double totalVolume = 0;
   double minVolume = 0;

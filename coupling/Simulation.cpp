@@ -3,9 +3,9 @@
 #include "core/Interrupt.hpp"
 #include "core/MeshConfig.hpp"
 #include "core/io/HostCopy.hpp"
-#include "core/parallel/Gather.hpp"
 #include "core/parallel/LocalMesh.hpp"
 #include "core/parallel/Partition.hpp"
+#include "kernels/Blas.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -203,30 +203,28 @@ void Simulation::decompose(const SceneConfig& scene, const std::string& partitio
   Kokkos::fence();
 }
 
-void Simulation::gatherPoints() {
-  if (ranks_ <= 1 || !hasMesh_) return;
-  const lid_t n = localMesh_.nOwnedNodes();
-  auto gid = Kokkos::create_mirror_view_and_copy(HostSpace(), localMesh_.nodeGlobalIds());
-  auto x = Kokkos::create_mirror_view_and_copy(HostSpace(), localMesh_.points());
-  std::vector<gid_t> ids(static_cast<std::size_t>(n));
-  std::vector<double> values(3 * static_cast<std::size_t>(n));
-  for (lid_t i = 0; i < n; ++i) {
-    ids[i] = gid(i);
-    for (int c = 0; c < 3; ++c) values[3 * static_cast<std::size_t>(i) + c] = x(i, c);
-  }
-  const std::vector<double> all =
-      gatherByGlobalId(MPI_COMM_WORLD, 0, ids, values, 3, static_cast<std::size_t>(mesh_.nNodes()));
-  if (rank_ != 0) return;
-  auto h = Kokkos::create_mirror_view(mesh_.points());
-  for (lid_t i = 0; i < mesh_.nNodes(); ++i)
-    for (int c = 0; c < 3; ++c) h(i, c) = all[3 * static_cast<std::size_t>(i) + c];
-  Kokkos::deep_copy(mesh_.points(), h);
-}
-
 void Simulation::meshMetrics(std::map<std::string, double>& m) const {
   if (!hasMesh_) return;
-  computeGeometry(ExecSpace(), mesh_, geometry_);  // the mesh may have moved since set-up
-  const MeshQuality q = computeQuality(ExecSpace(), mesh_, geometry_);
+  // The mesh may have moved since set-up. On several ranks each measures its part (its owned
+  // cells, each face once) and the parts are combined: nothing is gathered.
+  const bool decomposed = ranks_ > 1;
+  const HexMesh& part = decomposed ? localMesh_ : mesh_;
+  const MeshGeometry& geo = decomposed ? localGeometry_ : geometry_;
+  computeGeometry(ExecSpace(), part, geo);
+  MeshQuality q = computeQuality(ExecSpace(), part, geo);
+  if (decomposed) {  // through the solvers' communicator: sums in rank order, the same bits every run
+    const SolverComm comm(MPI_COMM_WORLD, nullptr);
+    q.minScaledJacobian = -comm.globalMax(-q.minScaledJacobian);
+    q.minVolume = -comm.globalMax(-q.minVolume);
+    q.maxNonOrthogonality = comm.globalMax(q.maxNonOrthogonality);
+    q.maxSkewness = comm.globalMax(q.maxSkewness);
+    q.maxVolume = comm.globalMax(q.maxVolume);
+    double sum[3] = {q.totalVolume, q.meanNonOrthogonality * static_cast<double>(q.countedFaces),
+                     static_cast<double>(q.countedFaces)};
+    comm.globalSum(sum, 3);
+    q.totalVolume = sum[0];
+    q.meanNonOrthogonality = sum[2] > 0 ? sum[1] / sum[2] : 0.0;
+  }
   m["mesh.min_scaled_jacobian"] = q.minScaledJacobian;
   m["mesh.max_non_orthogonality_deg"] = q.maxNonOrthogonality;
   m["mesh.mean_non_orthogonality_deg"] = q.meanNonOrthogonality;
@@ -382,7 +380,6 @@ RunResult Simulation::run(const std::string& outDir, bool terminal, bool continu
   r.simTime = ts.time;
   {
     ScopedTimer t(timers_, "metrics");
-    gatherPoints();
     meshMetrics(r.metrics);
     if (r.steadyStateReached) r.metrics["time.steady_state_reached"] = 1.0;
     r.metrics["output.field_frames"] = fields.frames();

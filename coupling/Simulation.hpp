@@ -94,6 +94,8 @@ class Simulation {
   /// Ranks of MPI_COMM_WORLD the run is decomposed over (1: the whole mesh here), and this one.
   int ranks() const { return ranks_; }
   int rank() const { return rank_; }
+  /// The scene's whole mesh: on one rank the mesh the run moves, on several as it was read (each
+  /// rank moves its own part).
   const HexMesh& mesh() const { return mesh_; }
   const std::vector<std::unique_ptr<Module>>& modules() const { return modules_; }
   Timers& timers() { return timers_; }
@@ -128,15 +130,13 @@ class Simulation {
   /// Build this rank's part of mesh_ (METIS over the ranks, each membrane's cells on one rank);
   /// throws InputError for what does not run on several ranks yet.
   void decompose(const SceneConfig& scene, const std::string& partitionFile);
-  /// Several ranks: the points of mesh_ on rank 0 <- the parts' moved points (collective).
-  void gatherPoints();
   /// The moved points from a checkpoint: `first` is rank 0's file, `states` this rank's part of
   /// the state (its own file, or one carried from another decomposition).
   void restorePoints(const io::Hdf5File& first, const io::Hdf5File& states);
 
   Timers timers_;
   bool hasMesh_ = false;
-  HexMesh mesh_;  ///< the whole mesh (every rank builds it; rank 0 writes it)
+  HexMesh mesh_;  ///< the whole mesh (every rank builds it; on several ranks it does not move)
   MeshGeometry geometry_;
   /// On several ranks: this rank's part of mesh_, its geometry, and the ranks it talks to.
   int ranks_ = 1, rank_ = 0;
