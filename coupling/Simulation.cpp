@@ -437,7 +437,8 @@ std::string Simulation::writeCheckpoint(const std::string& outDir, const TimeSta
   char name[64];
   std::snprintf(name, sizeof name, "%s%09lld.h5", kCheckpointPrefix, static_cast<long long>(ts.step));
   const std::string path = (dir / name).string();
-  // Every rank writes its file (its part's points and state, no gather); rank 0 commits its own only when all others have committed theirs.
+  // Every rank writes its file (its part's points and state, no gather); rank 0 commits its own
+  // only when all others have committed theirs.
   std::string failure;
   std::optional<io::Hdf5File> file;
   try {
@@ -573,7 +574,8 @@ void Simulation::restorePoints(const io::Hdf5File& first, const io::Hdf5File& st
     io::StateReader(states, "/mesh").getView("points", m.points());
     return;
   }
-  // A checkpoint written before its parts held their points: rank 0's file has the whole mesh's.
+  // A checkpoint written before its parts held their points: rank 0's file has the whole mesh's
+  // (read into mesh_, which on several ranks moves only here).
   io::StateReader(first, "/mesh").getView("points", mesh_.points());
   if (ranks_ == 1) return;
   auto whole = Kokkos::create_mirror_view_and_copy(HostSpace(), mesh_.points());

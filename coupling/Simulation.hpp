@@ -136,7 +136,7 @@ class Simulation {
 
   Timers timers_;
   bool hasMesh_ = false;
-  HexMesh mesh_;  ///< the whole mesh (every rank builds it; on several ranks it does not move)
+  HexMesh mesh_;  ///< the whole mesh (every rank builds it; on several ranks only the parts move)
   MeshGeometry geometry_;
   /// On several ranks: this rank's part of mesh_, its geometry, and the ranks it talks to.
   int ranks_ = 1, rank_ = 0;

@@ -214,7 +214,7 @@ TEST(FieldOutputNp2, AFaultOnOneRankAloneStopsTheFrameOnBoth) {
     std::string error;
     try {
       series.write(f);
-    } catch (const std::exception& e) {  // an OutputError from rank 0's layout, a logic_error from rank 1's rows
+    } catch (const std::exception& e) {  // rank 0's layout: an OutputError; rank 1's rows: a logic_error
       error = e.what();
     }
     const std::string field = faulty == 0 ? "/membrane/point/displacement" : "meshDisplacement";
