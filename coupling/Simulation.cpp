@@ -114,9 +114,9 @@ Simulation::Simulation(const SceneConfig& scene, const std::string& partitionFil
 
   SimulationContext ctx;
   if (hasMesh_) {
-    ctx.mesh = ranks_ > 1 ? &localMesh_ : &mesh_;
+    ctx.mesh = &ownMesh();
     ctx.wholeMesh = &mesh_;
-    ctx.geometry = ranks_ > 1 ? &localGeometry_ : &geometry_;
+    ctx.geometry = &ownGeometry();
     if (ranks_ > 1) ctx.domain = &domain_;
   }
   ctx.timers = &timers_;
@@ -207,12 +207,9 @@ void Simulation::meshMetrics(std::map<std::string, double>& m) const {
   if (!hasMesh_) return;
   // The mesh may have moved since set-up. On several ranks each measures its part (its owned
   // cells, each face once) and the parts are combined: nothing is gathered.
-  const bool decomposed = ranks_ > 1;
-  const HexMesh& part = decomposed ? localMesh_ : mesh_;
-  const MeshGeometry& geo = decomposed ? localGeometry_ : geometry_;
-  computeGeometry(ExecSpace(), part, geo);
-  MeshQuality q = computeQuality(ExecSpace(), part, geo);
-  if (decomposed) {  // through the solvers' communicator: sums in rank order, the same bits every run
+  computeGeometry(ExecSpace(), ownMesh(), ownGeometry());
+  MeshQuality q = computeQuality(ExecSpace(), ownMesh(), ownGeometry());
+  if (ranks_ > 1) {  // through the solvers' communicator: sums in rank order, the same bits every run
     const SolverComm comm(MPI_COMM_WORLD, nullptr);
     q.minScaledJacobian = -comm.globalMax(-q.minScaledJacobian);
     q.minVolume = -comm.globalMax(-q.minVolume);
@@ -240,7 +237,7 @@ void Simulation::meshMetrics(std::map<std::string, double>& m) const {
 io::OutputGrid Simulation::meshGrid() const {
   // On several ranks this rank's part (its owned points and cells, by global id), else the mesh.
   const bool decomposed = ranks_ > 1;
-  const HexMesh& m = decomposed ? localMesh_ : mesh_;
+  const HexMesh& m = ownMesh();
   io::OutputGrid g;
   g.name = "mesh";
   g.shape = io::CellShape::Hexahedron;
@@ -461,7 +458,7 @@ std::string Simulation::writeCheckpoint(const std::string& outDir, const TimeSta
     }
     if (hasMesh_) {  // the moved points of the mesh this rank computes on, by node (carried by global id)
       io::StateWriter mesh(*file, "/mesh");
-      mesh.putView("points", (ranks_ > 1 ? localMesh_ : mesh_).points(), io::Entity::Nodes);
+      mesh.putView("points", ownMesh().points(), io::Entity::Nodes);
     }
     if (ranks_ > 1 && hasMesh_) {  // what carries the state to another decomposition (restore)
       if (!partIds_) partIds_ = io::partIds(localMesh_, mesh_);
@@ -569,9 +566,8 @@ io::Hdf5File Simulation::carryCheckpoint(const io::Hdf5File& first, const std::s
 }
 
 void Simulation::restorePoints(const io::Hdf5File& first, const io::Hdf5File& states) {
-  HexMesh& m = ranks_ > 1 ? localMesh_ : mesh_;
   if (first.has(io::entityTagPath("/mesh/points"))) {  // each rank's file has its part's points
-    io::StateReader(states, "/mesh").getView("points", m.points());
+    io::StateReader(states, "/mesh").getView("points", ownMesh().points());
     return;
   }
   // A checkpoint written before its parts held their points: rank 0's file has the whole mesh's

@@ -130,6 +130,11 @@ class Simulation {
   /// Build this rank's part of mesh_ (METIS over the ranks, each membrane's cells on one rank);
   /// throws InputError for what does not run on several ranks yet.
   void decompose(const SceneConfig& scene, const std::string& partitionFile);
+  /// The mesh this rank computes on and its geometry: its part on several ranks, else the whole mesh.
+  HexMesh& ownMesh() { return ranks_ > 1 ? localMesh_ : mesh_; }
+  const HexMesh& ownMesh() const { return ranks_ > 1 ? localMesh_ : mesh_; }
+  MeshGeometry& ownGeometry() { return ranks_ > 1 ? localGeometry_ : geometry_; }
+  const MeshGeometry& ownGeometry() const { return ranks_ > 1 ? localGeometry_ : geometry_; }
   /// The moved points from a checkpoint: `first` is rank 0's file, `states` this rank's part of
   /// the state (its own file, or one carried from another decomposition).
   void restorePoints(const io::Hdf5File& first, const io::Hdf5File& states);
