@@ -200,6 +200,7 @@ void Simulation::decompose(const SceneConfig& scene, const std::string& partitio
   domain_.comm = MPI_COMM_WORLD;
   domain_.cells = lp.cells;
   domain_.nodes = lp.nodes;
+  domain_.incompleteNode = lp.incompleteNode;
   Kokkos::fence();
 }
 

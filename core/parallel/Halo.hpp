@@ -25,6 +25,7 @@ struct RankDomain {
   MPI_Comm comm = MPI_COMM_NULL;
   HaloPlan cells;
   HaloPlan nodes;
+  gid_t incompleteNode = -1;  ///< LocalMeshPart::incompleteNode
   bool distributed() const { return comm != MPI_COMM_NULL; }
 };
 

@@ -201,6 +201,21 @@ LocalMeshPart localMeshPart(const HexMesh& global, const std::vector<int>& cellR
       if (cellLocal[g.owner(f)] >= 0) ps.faces.push_back(localQuad(f));
     in.patches.push_back(std::move(ps));
   }
+
+  // Every owned node's edges in the part's cells, against the whole mesh's.
+  std::vector<std::vector<lid_t>> edges(static_cast<std::size_t>(part.nodes.nOwned));
+  for (const auto& cn : in.cells)
+    for (const auto& e : kHexEdges)
+      for (int s = 0; s < 2; ++s)
+        if (cn[e[s]] < part.nodes.nOwned) edges[cn[e[s]]].push_back(cn[e[1 - s]]);
+  auto wholeEdges = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), global.nodeNodeOffsets());
+  for (lid_t i = 0; i < part.nodes.nOwned; ++i) {
+    auto& a = edges[i];
+    std::sort(a.begin(), a.end());
+    a.erase(std::unique(a.begin(), a.end()), a.end());
+    const lid_t n = nodes[i];
+    if (static_cast<lid_t>(a.size()) != wholeEdges(n + 1) - wholeEdges(n)) part.incompleteNode = n;
+  }
   return part;
 }
 

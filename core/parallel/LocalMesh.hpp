@@ -39,6 +39,10 @@ struct LocalMeshPart {
   HexMeshInput input;   ///< to build the rank's HexMesh (global ids and owned counts filled)
   HaloPlan cells;
   HaloPlan nodes;
+  /// An owned node some of whose mesh edges lie only in cells the part lacks (cells that meet the
+  /// rank's cells at that node alone), by global id (the largest), or -1. Node-to-node work (the
+  /// mesh smoothing) needs every owned node's edges.
+  gid_t incompleteNode = -1;
 };
 
 /// \brief The part of `global` that `rank` holds under `cellRank` (one entry per global cell),

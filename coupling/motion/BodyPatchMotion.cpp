@@ -1,46 +1,81 @@
 #include "coupling/motion/BodyPatchMotion.hpp"
 
 #include "core/Error.hpp"
+#include "core/parallel/SharedNodes.hpp"
 
 #include <algorithm>
 
 namespace mfsi::coupling {
 
 BodyPatchMotion::BodyPatchMotion(const HexMesh& mesh, const std::vector<std::string>& patches)
-    : BodyPatchMotion(mesh, patches, mesh) {}
+    : BodyPatchMotion(mesh, patches, RankDomain{}) {}
 
-BodyPatchMotion::BodyPatchMotion(const HexMesh& whole, const std::vector<std::string>& patches, const HexMesh& part) {
-  auto fn = Kokkos::create_mirror_view_and_copy(HostSpace(), whole.faceNodes());
-  std::vector<lid_t> wholeNodes;
+BodyPatchMotion::BodyPatchMotion(const HexMesh& mesh, const std::vector<std::string>& patches,
+                                 const RankDomain& domain) {
+  const lid_t nn = mesh.nNodes();
+  auto fn = Kokkos::create_mirror_view_and_copy(HostSpace(), mesh.faceNodes());
+  std::vector<double> on(static_cast<std::size_t>(nn), 0.0);  // 1: a node of the patches' faces
   for (const auto& name : patches) {
-    const std::vector<int> indices = patchIndices(whole, name);
+    const std::vector<int> indices = patchIndices(mesh, name);
     MFSI_CHECK(!indices.empty(), "body patch motion: no patch or baffle '" << name << "'");
     for (int pi : indices) {
-      const auto& patch = whole.patches()[pi];
+      const auto& patch = mesh.patches()[pi];
       for (lid_t f = patch.start; f < patch.start + patch.size; ++f)
-        for (int a = 0; a < 4; ++a) wholeNodes.push_back(fn(f, a));
+        for (int a = 0; a < 4; ++a) on[fn(f, a)] = 1;
     }
   }
-  std::sort(wholeNodes.begin(), wholeNodes.end());
-  wholeNodes.erase(std::unique(wholeNodes.begin(), wholeNodes.end()), wholeNodes.end());
-  // The part's index of each of those nodes it holds (on one whole mesh: the same index).
-  std::vector<lid_t> local(static_cast<std::size_t>(whole.nNodes()), -1);
-  auto gid = Kokkos::create_mirror_view_and_copy(HostSpace(), part.nodeGlobalIds());
-  for (lid_t i = 0; i < part.nNodes(); ++i) local[static_cast<std::size_t>(gid(i))] = i;
-  for (lid_t v : wholeNodes)
-    if (local[v] >= 0) hostNodes_.push_back(local[v]);
+  if (domain.distributed()) {
+    // A node the rank holds is the body's when any rank holds a face of the patches at it.
+    MFSI_CHECK(domain.nodes.nLocal == nn, "body patch motion: a node plan of " << domain.nodes.nLocal
+                                                                               << " nodes for a part of " << nn);
+    foldGhostsIntoOwners(domain.comm, domain.nodes, 1, on, [&on](lid_t i, const double* copy) {
+      if (*copy != 0) on[i] = 1;
+    });
+    copyOwnersToGhosts(domain.comm, domain.nodes, 1, on);
+    owned_ = domain.nodes.nOwned;
+  } else {
+    owned_ = nn;
+  }
+  // In global-id order (on one mesh: the node order).
+  auto gid = Kokkos::create_mirror_view_and_copy(HostSpace(), mesh.nodeGlobalIds());
+  for (lid_t i = 0; i < nn; ++i)
+    if (on[i] != 0) hostNodes_.push_back(i);
+  std::sort(hostNodes_.begin(), hostNodes_.end(), [&gid](lid_t a, lid_t b) { return gid(a) < gid(b); });
+  comm_ = domain.comm;
+  for (lid_t v : hostNodes_) globalIds_.push_back(gid(v));
   const lid_t n = static_cast<lid_t>(hostNodes_.size());
   nodes_ = IndexView("mfsi::coupling::bodyPatch::nodes", n);
   reference_ = Real3View("mfsi::coupling::bodyPatch::reference", n);
   auto hn = Kokkos::create_mirror_view(nodes_);
   auto hr = Kokkos::create_mirror_view(reference_);
-  auto pts = Kokkos::create_mirror_view_and_copy(HostSpace(), part.points());
+  auto pts = Kokkos::create_mirror_view_and_copy(HostSpace(), mesh.points());
   for (lid_t i = 0; i < n; ++i) {
     hn(i) = hostNodes_[i];
     for (int k = 0; k < 3; ++k) hr(i, k) = pts(hostNodes_[i], k);
   }
   Kokkos::deep_copy(nodes_, hn);
   Kokkos::deep_copy(reference_, hr);
+}
+
+std::vector<std::array<real, 3>> BodyPatchMotion::allReferencePoints() const {
+  auto X = Kokkos::create_mirror_view_and_copy(HostSpace(), reference_);
+  std::vector<std::array<real, 3>> out;
+  if (comm_ == MPI_COMM_NULL) {
+    for (lid_t i = 0; i < nNodes(); ++i) out.push_back({X(i, 0), X(i, 1), X(i, 2)});
+    return out;
+  }
+  // The owned nodes' rows: every node of the patches is owned by one rank.
+  std::vector<gid_t> ids;
+  std::vector<double> values;
+  for (lid_t i = 0; i < nNodes(); ++i) {
+    if (hostNodes_[i] >= owned_) continue;
+    ids.push_back(globalIds_[i]);
+    values.insert(values.end(), {X(i, 0), X(i, 1), X(i, 2)});
+  }
+  const GatheredRows rows = gatherRowsEverywhere(comm_, ids, values, 3);
+  for (std::size_t i = 0; i < rows.ids.size(); ++i)
+    out.push_back({rows.values[3 * i], rows.values[3 * i + 1], rows.values[3 * i + 2]});
+  return out;
 }
 
 std::vector<int> BodyPatchMotion::patchIndices(const HexMesh& mesh, const std::string& name) {

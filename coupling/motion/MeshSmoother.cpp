@@ -2,6 +2,7 @@
 
 #include "core/Error.hpp"
 #include "core/PointTree.hpp"
+#include "core/parallel/SharedNodes.hpp"
 
 #include <algorithm>
 #include <array>
@@ -15,20 +16,35 @@ namespace {
 
 // The constructor's kernels are free functions: nvcc takes no device lambda in a constructor.
 
-/// Which nodes the smoother may move. fixed(i) = 1 for every node of a boundary face, except
-/// faces of empty patches (the front and back of a one-cell-thick 2D mesh: their nodes follow the
-/// in-plane motion; a displacement with no out-of-plane part prescribed anywhere keeps none after
-/// smoothing, exactly) and faces of sliding patches: a node all of whose other boundary faces are
-/// on sliding patches and share one plane slides in that plane (normal in `slide`), a node where
-/// sliding planes meet at an angle or a non-sliding face touches is fixed. Built on the host once.
-Kokkos::View<std::uint8_t*, MemSpace> boundaryNodes(const HexMesh& mesh, const std::vector<std::string>& sliding,
-                                                  Real3View& slide) {
+/// Which nodes the smoother may move, on the host: fixed[i] = 1 for every node of a boundary face,
+/// except faces of empty patches (the front and back of a one-cell-thick 2D mesh: their nodes
+/// follow the in-plane motion; a displacement with no out-of-plane part prescribed anywhere keeps
+/// none after smoothing, exactly) and faces of sliding patches: a node all of whose other boundary
+/// faces are on sliding patches and share one plane slides in that plane (its unit normal), a node
+/// where sliding planes meet at an angle or a non-sliding face touches is fixed. On a rank's part
+/// (`part`) the faces towards other ranks' cells are not the mesh's boundary.
+struct NodeRoles {
+  std::vector<std::uint8_t> fixed, slides;
+  std::vector<std::array<double, 3>> normal;
+
+  /// A sliding face's unit normal `n` at node v.
+  void slide(lid_t v, const double* n) {
+    if (!slides[v]) {
+      for (int c = 0; c < 3; ++c) normal[v][c] = n[c];
+      slides[v] = 1;
+    } else if (std::abs(normal[v][0] * n[0] + normal[v][1] * n[1] + normal[v][2] * n[2]) < 1 - 1e-9) {
+      fixed[v] = 1;  // a corner of sliding planes
+    }
+  }
+};
+
+NodeRoles boundaryRoles(const HexMesh& mesh, const std::vector<std::string>& sliding, bool part) {
   const lid_t nn = mesh.nNodes();
   const int np = static_cast<int>(mesh.patches().size());
   std::vector<int> role(np, 1);  // 0: empty, 1: prescribes, 2: slides
   for (int p = 0; p < np; ++p) {
     const Patch& pt = mesh.patches()[p];
-    if (pt.kind == PatchKind::Empty) role[p] = 0;
+    if (pt.kind == PatchKind::Empty || (part && pt.name == kProcessorPatch)) role[p] = 0;
     for (const auto& s : sliding)
       if (s == pt.name) role[p] = 2;
   }
@@ -37,13 +53,15 @@ Kokkos::View<std::uint8_t*, MemSpace> boundaryNodes(const HexMesh& mesh, const s
   auto fn = Kokkos::create_mirror_view_and_copy(HostSpace(), mesh.faceNodes());
   auto fp = Kokkos::create_mirror_view_and_copy(HostSpace(), mesh.facePatch());
   auto x = Kokkos::create_mirror_view_and_copy(HostSpace(), mesh.referencePoints());
-  std::vector<std::uint8_t> fixedH(nn, 0), hasSlide(nn, 0);
-  std::vector<std::array<double, 3>> normal(nn, {0, 0, 0});
+  NodeRoles roles;
+  roles.fixed.assign(nn, 0);
+  roles.slides.assign(nn, 0);
+  roles.normal.assign(nn, {0, 0, 0});
   for (lid_t f = mesh.nInternalFaces(); f < mesh.nFaces(); ++f) {
     const int r = fp(f) < 0 ? 1 : role[fp(f)];
     if (r == 0) continue;
     if (r == 1) {
-      for (int k = 0; k < 4; ++k) fixedH[fn(f, k)] = 1;
+      for (int k = 0; k < 4; ++k) roles.fixed[fn(f, k)] = 1;
       continue;
     }
     // Unit normal of the face from its diagonals.
@@ -56,23 +74,52 @@ Kokkos::View<std::uint8_t*, MemSpace> boundaryNodes(const HexMesh& mesh, const s
     n[1] = d1[2] * d2[0] - d1[0] * d2[2];
     n[2] = d1[0] * d2[1] - d1[1] * d2[0];
     const double len = std::sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
-    for (int k = 0; k < 4; ++k) {
-      const lid_t v = fn(f, k);
-      if (!hasSlide[v]) {
-        for (int c = 0; c < 3; ++c) normal[v][c] = n[c] / len;
-        hasSlide[v] = 1;
-      } else {
-        const double dot = normal[v][0] * n[0] / len + normal[v][1] * n[1] / len + normal[v][2] * n[2] / len;
-        if (std::abs(dot) < 1 - 1e-9) fixedH[v] = 1;  // a corner of sliding planes
-      }
-    }
+    for (int c = 0; c < 3; ++c) n[c] /= len;
+    for (int k = 0; k < 4; ++k) roles.slide(fn(f, k), n);
   }
+  return roles;
+}
+
+/// The roles on a rank's part made the mesh's: a node's copies on other ranks may see boundary
+/// faces this rank does not hold (in cells that meet its cells at that node alone). Each copy's
+/// roles are folded into the owner's as its faces would be, and the owner's copied back.
+void shareRoles(const RankDomain& domain, NodeRoles& roles) {
+  const lid_t nn = domain.nodes.nLocal;
+  std::vector<double> packed(static_cast<std::size_t>(nn) * 5);
+  for (lid_t i = 0; i < nn; ++i) {
+    double* p = &packed[static_cast<std::size_t>(i) * 5];
+    p[0] = roles.fixed[i];
+    p[1] = roles.slides[i];
+    for (int c = 0; c < 3; ++c) p[2 + c] = roles.normal[i][c];
+  }
+  foldGhostsIntoOwners(domain.comm, domain.nodes, 5, packed, [&roles](lid_t i, const double* copy) {
+    if (copy[0] != 0) roles.fixed[i] = 1;
+    if (copy[1] != 0) roles.slide(i, copy + 2);
+  });
+  for (lid_t i = 0; i < domain.nodes.nOwned; ++i) {
+    double* p = &packed[static_cast<std::size_t>(i) * 5];
+    p[0] = roles.fixed[i];
+    p[1] = roles.slides[i];
+    for (int c = 0; c < 3; ++c) p[2 + c] = roles.normal[i][c];
+  }
+  copyOwnersToGhosts(domain.comm, domain.nodes, 5, packed);
+  for (lid_t i = domain.nodes.nOwned; i < nn; ++i) {
+    const double* p = &packed[static_cast<std::size_t>(i) * 5];
+    roles.fixed[i] = p[0] != 0;
+    roles.slides[i] = p[1] != 0;
+    for (int c = 0; c < 3; ++c) roles.normal[i][c] = p[2 + c];
+  }
+}
+
+/// The prescribed flags on the device, and the slide normals (empty when no node slides).
+Kokkos::View<std::uint8_t*, MemSpace> deviceRoles(const NodeRoles& roles, Real3View& slide) {
+  const lid_t nn = static_cast<lid_t>(roles.fixed.size());
   Kokkos::View<std::uint8_t*, MemSpace> fixed("mfsi::coupling::motion::prescribed", nn);
   auto hf = Kokkos::create_mirror_view(fixed);
   bool any = false;
   for (lid_t i = 0; i < nn; ++i) {
-    hf(i) = fixedH[i];
-    any = any || (hasSlide[i] && !fixedH[i]);
+    hf(i) = roles.fixed[i];
+    any = any || (roles.slides[i] && !roles.fixed[i]);
   }
   Kokkos::deep_copy(fixed, hf);
   slide = Real3View();
@@ -80,7 +127,7 @@ Kokkos::View<std::uint8_t*, MemSpace> boundaryNodes(const HexMesh& mesh, const s
     slide = Real3View("mfsi::coupling::motion::slideNormal", nn);
     auto hs = Kokkos::create_mirror_view(slide);
     for (lid_t i = 0; i < nn; ++i)
-      for (int c = 0; c < 3; ++c) hs(i, c) = hasSlide[i] && !fixedH[i] ? normal[i][c] : 0.0;
+      for (int c = 0; c < 3; ++c) hs(i, c) = roles.slides[i] && !roles.fixed[i] ? roles.normal[i][c] : 0.0;
     Kokkos::deep_copy(slide, hs);
   }
   return fixed;
@@ -102,66 +149,31 @@ RealView inverseSquareEdgeWeights(const HexMesh& mesh) {
   return w;
 }
 
-/// The whole mesh's per-node flags and slide normals picked for one rank's nodes by global id.
-void localFlags(const HexMesh& part, const Kokkos::View<std::uint8_t*, MemSpace>& wholeFixed,
-                const Real3View& wholeSlide, Kokkos::View<std::uint8_t*, MemSpace>& fixed, Real3View& slide) {
-  const lid_t nn = part.nNodes();
-  auto gid = Kokkos::create_mirror_view_and_copy(HostSpace(), part.nodeGlobalIds());
-  auto wf = Kokkos::create_mirror_view_and_copy(HostSpace(), wholeFixed);
-  fixed = Kokkos::View<std::uint8_t*, MemSpace>("mfsi::coupling::motion::prescribed", nn);
-  auto hf = Kokkos::create_mirror_view(fixed);
-  for (lid_t i = 0; i < nn; ++i) hf(i) = wf(gid(i));
-  Kokkos::deep_copy(fixed, hf);
-  slide = Real3View();
-  if (wholeSlide.extent(0) == 0) return;
-  auto ws = Kokkos::create_mirror_view_and_copy(HostSpace(), wholeSlide);
-  slide = Real3View("mfsi::coupling::motion::slideNormal", nn);
-  auto hs = Kokkos::create_mirror_view(slide);
-  for (lid_t i = 0; i < nn; ++i)
-    for (int c = 0; c < 3; ++c) hs(i, c) = ws(gid(i), c);
-  Kokkos::deep_copy(slide, hs);
-}
-
-/// The global id of an owned node of `part` with fewer edges than in the whole mesh, or -1; the
-/// same answer on every rank of `comm` (the largest such id), so every rank stops together.
-long long incompleteRow(const HexMesh& part, const HexMesh& whole, MPI_Comm comm) {
-  auto gid = Kokkos::create_mirror_view_and_copy(HostSpace(), part.nodeGlobalIds());
-  auto po = Kokkos::create_mirror_view_and_copy(HostSpace(), part.nodeNodeOffsets());
-  auto wo = Kokkos::create_mirror_view_and_copy(HostSpace(), whole.nodeNodeOffsets());
-  long long bad = -1;
-  for (lid_t i = 0; i < part.nOwnedNodes() && bad < 0; ++i) {
-    const lid_t g = static_cast<lid_t>(gid(i));
-    if (po(i + 1) - po(i) != wo(g + 1) - wo(g)) bad = g;
-  }
-  MPI_Allreduce(MPI_IN_PLACE, &bad, 1, MPI_LONG_LONG, MPI_MAX, comm);
-  return bad;
-}
-
 }  // namespace
 
 MeshSmoother::MeshSmoother(const HexMesh& mesh, const MeshSmootherOptions& options)
-    : MeshSmoother(mesh, options, RankDomain{}, mesh) {}
+    : MeshSmoother(mesh, options, RankDomain{}) {}
 
-MeshSmoother::MeshSmoother(const HexMesh& mesh, const MeshSmootherOptions& options, const RankDomain& domain,
-                           const HexMesh& whole)
+MeshSmoother::MeshSmoother(const HexMesh& mesh, const MeshSmootherOptions& options, const RankDomain& domain)
     : mesh_(mesh), options_(options) {
   MFSI_CHECK(options_.sweeps >= 0, "mesh motion: sweeps must be >= 0, got " << options_.sweeps);
   MFSI_CHECK(options_.retries >= 0, "mesh motion: retries must be >= 0, got " << options_.retries);
   const lid_t nn = mesh.nNodes();
+  NodeRoles roles = boundaryRoles(mesh, options_.slidingPatches, domain.distributed());
   if (domain.distributed()) {
-    const long long bad = incompleteRow(mesh, whole, domain.comm);
+    long long bad = domain.incompleteNode;  // every rank stops together
+    MPI_Allreduce(MPI_IN_PLACE, &bad, 1, MPI_LONG_LONG, MPI_MAX, domain.comm);
     if (bad >= 0)
       throw InputError("mesh motion on several ranks: node " + std::to_string(bad) +
                        " has edges in cells its rank does not hold (cells that meet the rank's cells at a node "
                        "alone); run the scene on one rank");
-    Real3View wholeSlide;
-    const auto wholeFixed = boundaryNodes(whole, options_.slidingPatches, wholeSlide);
-    localFlags(mesh, wholeFixed, wholeSlide, fixed_, slide_);
+    MFSI_CHECK(domain.nodes.nLocal == nn,
+               "mesh motion: a node plan of " << domain.nodes.nLocal << " nodes for a part of " << nn);
+    shareRoles(domain, roles);
     nodeHalo_ = std::make_unique<Halo>(domain.comm, domain.nodes);
     comm_ = SolverComm(domain.comm, nodeHalo_.get());
-  } else {
-    fixed_ = boundaryNodes(mesh, options_.slidingPatches, slide_);
   }
+  fixed_ = deviceRoles(roles, slide_);
   graph_.offsets = mesh.nodeNodeOffsets();
   graph_.neighbours = mesh.nodeNodes();
   graph_.fixed = fixed_;

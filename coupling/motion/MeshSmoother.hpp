@@ -72,15 +72,14 @@ class MeshSmoother {
   /// empty patches (2D front and back) and sliding patches (nodes slide in the patch plane); the
   /// others are smoothed. Throws InputError for an unknown sliding patch. The mesh must outlive the smoother; `move` moves its points.
   MeshSmoother(const HexMesh& mesh, const MeshSmootherOptions& options);
-  /// \brief The same on one rank's part of a decomposed mesh (`domain` distributed): `whole` is
-  /// the whole mesh (every rank holds it at start-up), from which the prescribed and sliding nodes
-  /// are found, so that a node on the mesh's boundary is prescribed on every rank that holds it,
-  /// whichever of its faces the rank has. The owned nodes are smoothed, the ghosts follow their
-  /// owners through the node halo, and the quality guard takes the minimum over all ranks. Throws
-  /// InputError on every rank when an owned node's edges are not all on its rank (a mesh whose cells meet a
-  /// rank's cells at a node alone: the one ghost layer does not complete its row).
-  MeshSmoother(const HexMesh& mesh, const MeshSmootherOptions& options, const RankDomain& domain,
-               const HexMesh& whole);
+  /// \brief The same on one rank's part of a decomposed mesh (`domain` distributed). Each rank
+  /// finds the prescribed and sliding nodes on its part and the copies of a shared node agree
+  /// (core/parallel/SharedNodes), so a node on the mesh's boundary is prescribed on every rank that
+  /// holds it, whichever of its faces the rank has. The owned nodes are smoothed, the ghosts follow
+  /// their owners through the node halo, and the quality guard takes the minimum over all ranks.
+  /// Throws InputError on every rank when an owned node's edges are not all on its rank
+  /// (`domain.incompleteNode`: a mesh whose cells meet a rank's cells at a node alone).
+  MeshSmoother(const HexMesh& mesh, const MeshSmootherOptions& options, const RankDomain& domain);
 
   /// Displacement of every node from the reference mesh [m]: set the prescribed (boundary) entries
   /// before `move`; interior entries hold the last smoothed values.

@@ -2,14 +2,11 @@
 
 #include "core/Error.hpp"
 #include "core/HexGeometry.hpp"
+#include "core/PointTree.hpp"
 
 #include <Eigen/Geometry>
 
 #include <cmath>
-#include <functional>
-#include <limits>
-#include <queue>
-#include <utility>
 
 namespace mfsi::coupling {
 
@@ -19,67 +16,36 @@ double RigidBlend::weight(double distance, double inner, double outer) {
   return 0.5 * (1 + std::cos(M_PI * (distance - inner) / (outer - inner)));
 }
 
-std::vector<double> RigidBlend::nearestDistance(const HexMesh& mesh, const std::vector<lid_t>& sources) {
-  const lid_t n = mesh.nNodes();
+std::vector<double> RigidBlend::nearestDistance(const HexMesh& mesh, const std::vector<std::array<real, 3>>& sources) {
+  const PointTree tree(sources);
   auto X = Kokkos::create_mirror_view_and_copy(HostSpace(), mesh.referencePoints());
-  auto off = Kokkos::create_mirror_view_and_copy(HostSpace(), mesh.nodeNodeOffsets());
-  auto nb = Kokkos::create_mirror_view_and_copy(HostSpace(), mesh.nodeNodes());
-  std::vector<double> dist(static_cast<std::size_t>(n), std::numeric_limits<double>::infinity());
-  std::vector<lid_t> nearest(static_cast<std::size_t>(n), -1);
-  using Entry = std::pair<double, lid_t>;
-  std::priority_queue<Entry, std::vector<Entry>, std::greater<Entry>> queue;
-  for (lid_t s : sources) {
-    MFSI_ASSERT(s >= 0 && s < n, "rigid blend: source node " << s << " outside the mesh");
-    dist[s] = 0;
-    nearest[s] = s;
-    queue.push({0.0, s});
-  }
-  auto distance = [&](lid_t a, lid_t b) {
-    const double d0 = X(a, 0) - X(b, 0), d1 = X(a, 1) - X(b, 1), d2 = X(a, 2) - X(b, 2);
-    return std::sqrt(d0 * d0 + d1 * d1 + d2 * d2);
-  };
-  // Dijkstra's order on the straight distance to the propagated nearest source: a node is final
-  // when it leaves the queue, and offers its source to its neighbours.
-  while (!queue.empty()) {
-    const auto [d, v] = queue.top();
-    queue.pop();
-    if (d > dist[v]) continue;
-    const lid_t s = nearest[v];
-    for (lid_t k = off(v); k < off(v + 1); ++k) {
-      const lid_t u = nb(k);
-      const double du = distance(u, s);
-      if (du < dist[u]) {
-        dist[u] = du;
-        nearest[u] = s;
-        queue.push({du, u});
-      }
-    }
-  }
+  std::vector<double> dist(static_cast<std::size_t>(mesh.nNodes()));
+  for (lid_t v = 0; v < mesh.nNodes(); ++v)
+    dist[static_cast<std::size_t>(v)] = std::sqrt(tree.nearestSquaredDistance({X(v, 0), X(v, 1), X(v, 2)}));
   return dist;
 }
 
-RigidBlend::RigidBlend(const HexMesh& whole, const std::vector<Body>& bodies, const HexMesh& part)
+RigidBlend::RigidBlend(const std::vector<Body>& bodies, const HexMesh& mesh)
     : nBodies_(static_cast<int>(bodies.size())) {
   if (nBodies_ == 0) return;
-  const lid_t n = part.nNodes();
+  const lid_t n = mesh.nNodes();
   std::vector<std::vector<double>> distances;
   for (const Body& b : bodies) {
     MFSI_CHECK(b.outerDistance > b.innerDistance && b.innerDistance >= 0,
                "rigid blend: the distances must satisfy 0 <= innerDistance < outerDistance");
-    distances.push_back(nearestDistance(whole, b.nodes));
+    distances.push_back(nearestDistance(mesh, b.points));
   }
-  auto gid = Kokkos::create_mirror_view_and_copy(HostSpace(), part.nodeGlobalIds());
   hostWeights_.assign(static_cast<std::size_t>(n) * nBodies_, 0);
   for (lid_t v = 0; v < n; ++v)
     for (int b = 0; b < nBodies_; ++b)
       hostWeights_[static_cast<std::size_t>(v) * nBodies_ + b] = static_cast<real>(
-          weight(distances[b][static_cast<std::size_t>(gid(v))], bodies[b].innerDistance, bodies[b].outerDistance));
+          weight(distances[b][static_cast<std::size_t>(v)], bodies[b].innerDistance, bodies[b].outerDistance));
   weights_ = Kokkos::View<real**, MemSpace>("mfsi::coupling::rigidBlend::weights", n, nBodies_);
   auto hw = Kokkos::create_mirror_view(weights_);
   for (lid_t v = 0; v < n; ++v)
     for (int b = 0; b < nBodies_; ++b) hw(v, b) = hostWeights_[static_cast<std::size_t>(v) * nBodies_ + b];
   Kokkos::deep_copy(weights_, hw);
-  reference_ = part.referencePoints();
+  reference_ = mesh.referencePoints();
   screws_ = Kokkos::View<real* [10], MemSpace>("mfsi::coupling::rigidBlend::screws", nBodies_);
 }
 

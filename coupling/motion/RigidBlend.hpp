@@ -4,7 +4,7 @@
 /// each coupled rigid body carries the mesh near it rigidly, a share w(d) of its motion that is 1
 /// within `innerDistance` of the body's patches, 0 beyond `outerDistance` and
 /// (1 + cos(pi (d - inner) / (outer - inner))) / 2 in between (d: distance to the nearest node of
-/// the body's patches, along the mesh).
+/// the body's patches, on the reference mesh).
 ///
 /// A node's share of a body's motion follows the motion's screw instead of blending positions:
 /// the rotation by w times the body's rotation angle about the same axis (the slerp of the
@@ -19,29 +19,29 @@
 #include "core/HexMesh.hpp"
 #include "core/RigidPlacement.hpp"
 
+#include <array>
 #include <vector>
 
 namespace mfsi::coupling {
 
 class RigidBlend {
  public:
-  /// \brief One body: the whole mesh's nodes it carries (its patches') and its two distances [m].
+  /// \brief One body: the reference positions of the nodes it carries (its patches', on every
+  /// rank: BodyPatchMotion::allReferencePoints) and its two distances [m].
   struct Body {
-    std::vector<lid_t> nodes;
+    std::vector<std::array<real, 3>> points;
     double innerDistance = 0;
     double outerDistance = 0;
   };
 
   RigidBlend() = default;
-  /// The weights of `part`'s nodes (found in `whole` by global id; on one rank the same mesh), from
-  /// each node's distance to the nearest node of each body, measured on the reference mesh.
-  RigidBlend(const HexMesh& whole, const std::vector<Body>& bodies, const HexMesh& part);
+  /// The weights of `mesh`'s nodes (a rank's part or the whole mesh), from each node's distance to
+  /// the nearest of each body's points, on the reference mesh.
+  RigidBlend(const std::vector<Body>& bodies, const HexMesh& mesh);
 
-  /// Distance of every node of `mesh` to the nearest of `sources` (node indices), through the
-  /// mesh's edges: each node takes, from the neighbour that offers the nearest, that neighbour's
-  /// nearest source, and its straight distance to it (a node-to-node wave, exact on convex
-  /// regions of the mesh). Host, on the reference points.
-  static std::vector<double> nearestDistance(const HexMesh& mesh, const std::vector<lid_t>& sources);
+  /// Straight distance of every node of `mesh` (reference positions) to the nearest of `sources`
+  /// (a k-d tree; host).
+  static std::vector<double> nearestDistance(const HexMesh& mesh, const std::vector<std::array<real, 3>>& sources);
 
   /// w(d) of the class comment.
   static double weight(double distance, double inner, double outer);

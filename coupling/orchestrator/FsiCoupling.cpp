@@ -44,6 +44,7 @@ FsiCoupling::FsiCoupling(const CouplingOptions& options, const SceneConfig& sect
       options_(options),
       mesh_(mesh),
       whole_(whole != nullptr ? *whole : mesh),
+      domain_(domain != nullptr ? *domain : RankDomain{}),
       comm_(domain != nullptr && domain->distributed() ? domain->comm : MPI_COMM_NULL),
       timers_(timers),
       fluid_(std::move(fluid)),
@@ -127,16 +128,16 @@ FsiCoupling::FsiCoupling(const CouplingOptions& options, const SceneConfig& sect
   setUpParents(section);
   setUpChamber(section);
   smoother_ = comm_ != MPI_COMM_NULL
-                  ? std::make_unique<coupling::MeshSmoother>(mesh_, options_.motion, *domain, whole_)
+                  ? std::make_unique<coupling::MeshSmoother>(mesh_, options_.motion, *domain)
                   : std::make_unique<coupling::MeshSmoother>(mesh_, options_.motion);
   if (!options_.bodyReach.empty()) {
     std::vector<coupling::RigidBlend::Body> reach;
     for (const auto& r : options_.bodyReach) {
       const auto it = std::find_if(bodies_.begin(), bodies_.end(), [&](const CoupledBody& b) { return b.name == r.body; });
       reach_.slot.push_back(static_cast<int>(it - bodies_.begin()));
-      reach.push_back({coupling::BodyPatchMotion(whole_, it->patches).hostNodes(), r.innerDistance, r.outerDistance});
+      reach.push_back({it->motion.allReferencePoints(), r.innerDistance, r.outerDistance});
     }
-    reach_.blend = coupling::RigidBlend(whole_, reach, mesh_);
+    reach_.blend = coupling::RigidBlend(reach, mesh_);
     reach_.base = Real3View("mfsi::coupling::rigidBase", mesh_.nNodes());
     reach_.transforms.resize(reach.size());
     smoother_->setBase(reach_.base);
@@ -146,10 +147,8 @@ FsiCoupling::FsiCoupling(const CouplingOptions& options, const SceneConfig& sect
     auto X = Kokkos::create_mirror_view_and_copy(HostSpace(), whole_.referencePoints());
     for (const Panel& p : panels_)
       for (lid_t v : p.module->fluidSurface()->fluidNode) moving.push_back({X(v, 0), X(v, 1), X(v, 2)});
-    for (const CoupledBody& b : bodies_) {
-      const coupling::BodyPatchMotion patches(whole_, b.patches);
-      for (lid_t v : patches.hostNodes()) moving.push_back({X(v, 0), X(v, 1), X(v, 2)});
-    }
+    for (const CoupledBody& b : bodies_)
+      for (const auto& x : b.motion.allReferencePoints()) moving.push_back(x);
     smoother_->setMovingNodes(moving);
   }
   if (options_.motion.columns) {
@@ -349,7 +348,7 @@ void FsiCoupling::setUpBodies(const SceneConfig& section, std::vector<coupling::
     for (std::size_t i = 0; i < bp.patches.size(); ++i) {
       const std::string& name = bp.patches[i];
       const std::string at = key + "." + std::to_string(i);
-      if (coupling::BodyPatchMotion::patchIndices(whole_, name).empty())
+      if (coupling::BodyPatchMotion::patchIndices(mesh_, name).empty())
         throw InputError(section.where(at), mesh_.noPatchMessage(name) + " (or a baffle of that name)");
       for (int pi : bc.find(name)) {
         const fluid::ResolvedPatch& rp = bc.patches()[pi];
@@ -358,7 +357,7 @@ void FsiCoupling::setUpBodies(const SceneConfig& section, std::vector<coupling::
                                                   ": make it 'type: movingWall' (wall velocity from the mesh motion)");
       }
     }
-    b.motion = coupling::BodyPatchMotion(whole_, bp.patches, mesh_);
+    b.motion = coupling::BodyPatchMotion(mesh_, bp.patches, domain_);
     b.com0 = kin.bodies[b.index].com;
     b.rotation0 = kin.bodies[b.index].frame.rotation;
     bodies_.push_back(std::move(b));
@@ -372,7 +371,6 @@ void FsiCoupling::setUpBodies(const SceneConfig& section, std::vector<coupling::
 
 void FsiCoupling::setUpParents(const SceneConfig& section) {
   if (options_.parentBodyPatches.empty()) return;
-  auto pts = Kokkos::create_mirror_view_and_copy(HostSpace(), whole_.points());  // the reference mesh
   const std::vector<std::string> names = membraneNames();
   for (const auto& pp : options_.parentBodyPatches) {
     const std::string key = "parentBodyPatches." + pp.membrane;
@@ -397,9 +395,9 @@ void FsiCoupling::setUpParents(const SceneConfig& section) {
       if (slot < 0)
         throw InputError(section.where(key + "." + std::to_string(i)),
                          "'" + name + "' is not a patch of a coupled body (bodyPatches)");
-      const coupling::BodyPatchMotion patch(whole_, {name});
-      for (lid_t v : patch.hostNodes()) {
-        candidates.push_back({pts(v, 0), pts(v, 1), pts(v, 2)});
+      const coupling::BodyPatchMotion patch(mesh_, {name}, domain_);
+      for (const auto& x : patch.allReferencePoints()) {
+        candidates.push_back(x);
         candidateBody.push_back(slot);
       }
     }

@@ -205,6 +205,7 @@ class FsiCoupling final : public Module {
   CouplingOptions options_;
   HexMesh& mesh_;
   const HexMesh& whole_;  ///< the whole mesh (mesh_ itself on one rank)
+  RankDomain domain_;     ///< the other ranks' parts (none on one rank)
   MPI_Comm comm_ = MPI_COMM_NULL;  ///< several ranks: the ranks
   int rank_ = 0;                    ///< this rank in comm_ (0 on one rank)
   Timers& timers_;

@@ -153,6 +153,38 @@ TEST(LocalMesh, OneRankIsTheWholeMeshWithoutGhosts) {
   EXPECT_EQ(local.patches().size(), global.patches().size());
 }
 
+TEST(LocalMesh, NamesAnOwnedNodeWhoseEdgesLieInCellsThePartLacks) {
+  // Two unit cubes that touch at one corner, the node (1, 1, 1): on 2 ranks, one cube each, no
+  // face joins them, so neither part holds the other cube, and the corner's three edges in it
+  // are missing from the rank that owns the corner (rank 0, the lower).
+  HexMeshInput in;
+  in.source = "two cubes meeting at a corner";
+  auto cube = [&](double o) {
+    std::array<lid_t, 8> c;
+    const double x[8][3] = {{0, 0, 0}, {1, 0, 0}, {1, 1, 0}, {0, 1, 0}, {0, 0, 1}, {1, 0, 1}, {1, 1, 1}, {0, 1, 1}};
+    for (int k = 0; k < 8; ++k) {
+      const std::array<real, 3> p = {x[k][0] + o, x[k][1] + o, x[k][2] + o};
+      auto it = std::find(in.points.begin(), in.points.end(), p);
+      c[k] = static_cast<lid_t>(it - in.points.begin());
+      if (it == in.points.end()) in.points.push_back(p);
+    }
+    in.cells.push_back(c);
+  };
+  cube(0);
+  cube(1);
+  const HexMesh global = buildHexMesh(in);
+  ASSERT_EQ(global.nNodes(), 15);
+  const LocalMeshPart zero = localMeshPart(global, {0, 1}, 2, 0), one = localMeshPart(global, {0, 1}, 2, 1);
+  EXPECT_EQ(zero.incompleteNode, 6) << "the shared corner, owned by rank 0";
+  EXPECT_EQ(one.incompleteNode, -1) << "rank 1 owns only its own cube's other nodes";
+  // A box's parts are complete, even under a random partition (without a baffle: cells across a
+  // baffle share nodes but no face, which is why a baffle's cells stay on one rank).
+  const HexMeshInput box = generateBlockMesh(boxSpec({0, 0, 0}, {1, 1, 1}, {6, 5, 4}));
+  const HexMesh boxMesh = buildHexMesh(box);
+  const std::vector<int> random = test::randomPartition(box.cells.size(), 4);
+  for (int r = 0; r < 4; ++r) EXPECT_EQ(localMeshPart(boxMesh, random, 4, r).incompleteNode, -1) << "rank " << r;
+}
+
 TEST(Partition, BuiltMeshGraphEqualsTheInputGraph) {
   // Baffle faces are boundary faces of the built mesh; its graph joins their two cells all the same.
   const HexMeshInput in = test::longBoxWithBaffle();

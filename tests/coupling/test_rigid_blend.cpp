@@ -1,7 +1,7 @@
 // The distance-weighted rigid part of the mesh motion (coupling/motion/RigidBlend, the seed's
 // section 3.2), on a box with a square hole (the body) turned about its centre:
-//  - the distance wave gives the exact distance to the nearest node of a convex body, and the
-//    weight its three ranges;
+//  - the distance is the exact distance to the nearest node of the body, and the weight has its
+//    three ranges;
 //  - a share w of a turn is the turn by w times the angle: half of a 180-degree turn is a
 //    90-degree turn (a blend of positions would put the node on the axis);
 //  - nodes within innerDistance move exactly rigidly, nodes beyond outerDistance not at all;
@@ -67,6 +67,13 @@ std::vector<lid_t> patchNodes(const mfsi::HexMesh& mesh, const std::string& name
   return out;
 }
 
+std::vector<std::array<mfsi::real, 3>> patchPoints(const mfsi::HexMesh& mesh, const std::string& name) {
+  auto X = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), mesh.referencePoints());
+  std::vector<std::array<mfsi::real, 3>> out;
+  for (lid_t v : patchNodes(mesh, name)) out.push_back({X(v, 0), X(v, 1), X(v, 2)});
+  return out;
+}
+
 /// z-rotation of (x, y) by angle a.
 std::array<double, 2> turned(double x, double y, double a) {
   return {std::cos(a) * x - std::sin(a) * y, std::sin(a) * x + std::cos(a) * y};
@@ -83,7 +90,7 @@ TEST(RigidBlend, DistanceAndWeight) {
   const auto mesh = boxWithHole(4, 6);
   const std::vector<lid_t> body = patchNodes(mesh, "body");
   auto X = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), mesh.referencePoints());
-  const auto d = RigidBlend::nearestDistance(mesh, body);
+  const auto d = RigidBlend::nearestDistance(mesh, patchPoints(mesh, "body"));
   for (lid_t v = 0; v < mesh.nNodes(); ++v) {
     double exact = 1e300;
     for (lid_t s : body)
@@ -96,8 +103,8 @@ TEST(RigidBlend, DistanceAndWeight) {
 TEST(RigidBlend, AShareOfATurnIsTheTurnByThatShareOfTheAngle) {
   const auto mesh = boxWithHole(4, 6);
   const double inner = 0.25, outer = 0.75;
-  const RigidBlend blend(mesh, {{patchNodes(mesh, "body"), inner, outer}}, mesh);
-  const auto d = RigidBlend::nearestDistance(mesh, patchNodes(mesh, "body"));
+  const RigidBlend blend({{patchPoints(mesh, "body"), inner, outer}}, mesh);
+  const auto d = RigidBlend::nearestDistance(mesh, patchPoints(mesh, "body"));
   mfsi::ExecSpace exec;
   mfsi::Real3View base("base", mesh.nNodes());
   const double angle = M_PI;
@@ -141,7 +148,7 @@ TEST(RigidBlend, ATurnedBodyKeepsTheCellsNextToItValid) {
     o.relTol = 1e-8;
     MeshSmoother s(mesh, o);
     const std::vector<lid_t> body = patchNodes(mesh, "body");
-    const RigidBlend blend(mesh, {{body, 0.15, 2.4}}, mesh);
+    const RigidBlend blend({{patchPoints(mesh, "body"), 0.15, 2.4}}, mesh);
     mfsi::ExecSpace exec;
     mfsi::Real3View base("base", mesh.nNodes());
     const double a = degrees * M_PI / 180;
