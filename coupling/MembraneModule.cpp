@@ -22,8 +22,11 @@ double periodFromZeroCrossings(const std::vector<double>& w, double dt) {
 }  // namespace
 
 MembraneModule::MembraneModule(const MembranePanelOptions& options) : Module(options.name), panel_(options) {
-  // A membrane cut from the fluid mesh keeps the maps of its surface for the coupling.
-  if (panel_.mesh.kind == MembraneMeshKind::Baffle)
+  // A membrane cut from the fluid mesh keeps the maps of its surface for the coupling (on several
+  // ranks the options hold it, cut by the rank that holds it).
+  if (panel_.mesh.surface)
+    surface_ = *panel_.mesh.surface;
+  else if (panel_.mesh.kind == MembraneMeshKind::Baffle)
     surface_ = membraneMeshFromBaffle(*panel_.mesh.fluidMesh, panel_.mesh.baffle);
   else if (panel_.mesh.kind == MembraneMeshKind::Patch)
     surface_ = membraneMeshFromPatch(*panel_.mesh.fluidMesh, panel_.mesh.patch);
@@ -169,7 +172,9 @@ void MembraneModule::addMetrics(std::map<std::string, double>& metrics) const {
 ModuleEntry membraneModuleEntry() {
   return {"membranes", &membraneSchema, [](const SceneConfig& section, SimulationContext& ctx) {
             std::vector<std::unique_ptr<Module>> v;
-            for (const auto& panel : readMembraneOptions(section, ctx.wholeMesh != nullptr ? ctx.wholeMesh : ctx.mesh)) v.push_back(std::make_unique<MembraneModule>(panel));
+            const MPI_Comm comm = ctx.domain != nullptr ? ctx.domain->comm : MPI_COMM_NULL;
+            for (const auto& panel : readMembraneOptions(section, ctx.mesh, comm))
+              v.push_back(std::make_unique<MembraneModule>(panel));
             return v;
           }};
 }

@@ -29,9 +29,6 @@ struct SimulationContext {
   MeshGeometry* geometry = nullptr;
   /// On several ranks: `mesh` is this rank's part and this names the others (null: one rank).
   const RankDomain* domain = nullptr;
-  /// The whole scene mesh (`mesh` itself on one rank): what membranes are cut from, so that every
-  /// rank holds the same membranes.
-  const HexMesh* wholeMesh = nullptr;
   Timers* timers = nullptr;
   /// The modules built so far: a module that composes others (the coupling) takes them from here.
   std::vector<std::unique_ptr<class Module>>* built = nullptr;

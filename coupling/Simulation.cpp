@@ -115,7 +115,6 @@ Simulation::Simulation(const SceneConfig& scene, const std::string& partitionFil
   SimulationContext ctx;
   if (hasMesh_) {
     ctx.mesh = &ownMesh();
-    ctx.wholeMesh = &mesh_;
     ctx.geometry = &ownGeometry();
     if (ranks_ > 1) ctx.domain = &domain_;
   }

@@ -30,7 +30,9 @@ MembraneInterface makeMembraneInterface(const HexMesh& mesh, const FluidSurfaceM
   MembraneInterface m;
   m.surface = name;
   m.side = side;
-  m.fluidNode = toDevice(surface.fluidNode, "mfsi::coupling::interface::fluidNode");
+  std::vector<lid_t> node;  // on one mesh: a node's global id is its index
+  for (gid_t g : surface.fluidNode) node.push_back(static_cast<lid_t>(g));
+  m.fluidNode = toDevice(node, "mfsi::coupling::interface::fluidNode");
   m.front = toDeviceShifted(surface.masterFace, "mfsi::coupling::interface::front", nIn);
   m.back = side == InterfaceSide::Baffle ? toDeviceShifted(surface.slaveFace, "mfsi::coupling::interface::back", nIn)
                                          : IndexView("mfsi::coupling::interface::back", 0);

@@ -7,6 +7,7 @@
 #include <array>
 #include <map>
 #include <string>
+#include <unordered_map>
 #include <vector>
 
 namespace mfsi::coupling {
@@ -24,33 +25,37 @@ FaceKey faceKey(const FaceNodes& fn, const Gid& gid, lid_t f) {
   return k;
 }
 
+FaceKey sorted(FaceKey k) {
+  std::sort(k.begin(), k.end());
+  return k;
+}
+
 /// Slot values packed per slot: pressure, vector area (3), area, centroid (3).
 constexpr int kGeometryWidth = 8;
 
 }  // namespace
 
-SurfaceGather::SurfaceGather(const HexMesh& whole, const HexMesh& part, MPI_Comm comm,
-                             const FluidSurfaceMembraneInput& surface, const std::string& name, InterfaceSide side)
-    : comm_(comm), side_(side), nElements_(static_cast<lid_t>(surface.masterFace.size())) {
+SurfaceGather::SurfaceGather(const HexMesh& part, MPI_Comm comm, const FluidSurfaceMembraneInput& surface,
+                             const std::string& name, InterfaceSide side)
+    : comm_(comm), side_(side), nElements_(surface.nElements()) {
   const lid_t n = nElements_;
   nSides_ = side == InterfaceSide::Baffle ? 2 : 1;
-  MFSI_CHECK(nSides_ == 1 || surface.slaveFace.size() == surface.masterFace.size(),
+  MFSI_CHECK(nSides_ == 1 || surface.slaveFaceNodes.size() == surface.masterFaceNodes.size(),
              "coupling: baffle interface '" << name << "' needs one slave face per master face");
-  auto wfn = Kokkos::create_mirror_view_and_copy(HostSpace(), whole.faceNodes());
   auto pfn = Kokkos::create_mirror_view_and_copy(HostSpace(), part.faceNodes());
   auto pown = Kokkos::create_mirror_view_and_copy(HostSpace(), part.faceOwner());
   auto pgid = Kokkos::create_mirror_view_and_copy(HostSpace(), part.nodeGlobalIds());
-  auto identity = [](lid_t i) { return static_cast<gid_t>(i); };
   const lid_t nIn = part.nInternalFaces();
   std::vector<int> owners(static_cast<std::size_t>(nSides_ * n), 0);
   for (int s = 0; s < nSides_; ++s) {
     Side& sd = sides_[s];
     sd.patch = side == InterfaceSide::Patch ? name : name + (s == 0 ? "_master" : "_slave");
-    const std::vector<lid_t>& wholeFaces = s == 0 ? surface.masterFace : surface.slaveFace;
+    const std::vector<FaceKey>& faces = s == 0 ? surface.masterFaceNodes : surface.slaveFaceNodes;
     std::map<FaceKey, lid_t> element;
-    for (lid_t e = 0; e < n; ++e) element[faceKey(wfn, identity, wholeFaces[e])] = e;
+    for (lid_t e = 0; e < n; ++e) element[sorted(faces[e])] = e;
     const int pi = part.findPatch(sd.patch);
     std::vector<lid_t> patchElement, ownedFace(static_cast<std::size_t>(n), -1);
+    sd.ownedCell.assign(static_cast<std::size_t>(n), -1);
     if (pi >= 0) {
       const Patch& p = part.patches()[pi];
       sd.patchStart = p.start;
@@ -60,6 +65,7 @@ SurfaceGather::SurfaceGather(const HexMesh& whole, const HexMesh& part, MPI_Comm
         patchElement.push_back(it->second);
         if (pown(f) < part.nOwnedCells()) {
           ownedFace[it->second] = f - nIn;
+          sd.ownedCell[it->second] = pown(f);
           ++owners[static_cast<std::size_t>(s * n + it->second)];
         }
       }
@@ -90,9 +96,13 @@ SurfaceGather::SurfaceGather(const HexMesh& whole, const HexMesh& part, MPI_Comm
                        " ranks instead of one (a baffle split between ranks whose cells do not neighbour)");
 
   // The membrane nodes on this rank's part.
-  std::vector<lid_t> local(static_cast<std::size_t>(whole.nNodes()), -1), node;
-  for (lid_t i = 0; i < part.nNodes(); ++i) local[static_cast<std::size_t>(pgid(i))] = i;
-  for (lid_t v : surface.fluidNode) node.push_back(local[static_cast<std::size_t>(v)]);
+  std::unordered_map<gid_t, lid_t> local;
+  for (lid_t i = 0; i < part.nNodes(); ++i) local.emplace(pgid(i), i);
+  std::vector<lid_t> node;
+  for (gid_t v : surface.fluidNode) {
+    const auto it = local.find(v);
+    node.push_back(it != local.end() ? it->second : -1);
+  }
   std::vector<lid_t> front(static_cast<std::size_t>(n)), back;
   for (lid_t e = 0; e < n; ++e) front[e] = e;
   if (nSides_ == 2)

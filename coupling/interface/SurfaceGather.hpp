@@ -3,7 +3,7 @@
 /// \brief The fluid's values on a membrane's surface, in the membrane's element order, on every
 /// rank: what lets the membrane be solved from the same loads whatever the rank count.
 ///
-/// A membrane is cut from the whole fluid mesh (every rank builds the same one). On a decomposed
+/// Every rank holds the same membrane (cut by the rank that holds it). On a decomposed
 /// mesh each of its faces is owned by the rank that owns the face's cell; that rank writes the
 /// face's values (pressure, vector area, area, centroid, and the tractions when asked) into the
 /// face's slot and the others write zeros, and one sum over the ranks completes every slot. Each
@@ -27,15 +27,22 @@ namespace mfsi::coupling {
 class SurfaceGather {
  public:
   SurfaceGather() = default;
-  /// `surface` was built from `whole` (the whole fluid mesh); `part` is this rank's mesh (the
-  /// same object on one rank) and `comm` the ranks (MPI_COMM_NULL: one rank). Throws InputError
-  /// when a face of the surface is owned by no rank, or by several.
-  SurfaceGather(const HexMesh& whole, const HexMesh& part, MPI_Comm comm, const FluidSurfaceMembraneInput& surface,
-                const std::string& name, InterfaceSide side);
+  /// `surface` names its nodes and faces by global ids (membraneMeshFromBaffle, cutMembraneOnRanks);
+  /// `part` is this rank's mesh (the whole mesh on one rank) and `comm` the ranks (MPI_COMM_NULL:
+  /// one rank). Throws InputError when a face of the surface is owned by no rank, or by several.
+  SurfaceGather(const HexMesh& part, MPI_Comm comm, const FluidSurfaceMembraneInput& surface, const std::string& name,
+                InterfaceSide side);
 
   /// The interface on the gathered slots, with the membrane nodes' indices in `part` (-1 for a
   /// node the rank does not hold).
   const MembraneInterface& gatheredInterface() const { return iface_; }
+
+  /// Per element, the cell of this rank's part that owns its face on `side` (0: the front, 1: a
+  /// baffle's slave side) when this rank owns that cell, else -1: each element's cell is owned by
+  /// one rank.
+  const std::vector<lid_t>& ownedCells(int side) const { return sides_[side].ownedCell; }
+  /// 2 on a baffle, else 1.
+  int sides() const { return nSides_; }
 
   /// The rank that owns every face of the surface (its cells' rank; 0 on one rank), or -1 when
   /// its faces are spread over ranks.
@@ -70,6 +77,7 @@ class SurfaceGather {
     IndexView ownedFace;        ///< per element: its face here if this rank owns it, else -1
     Real3View velocity;         ///< per face of the patch here: wall velocity (work)
     Real3View tractionP, tractionV;  ///< per face of the patch here: boundaryTraction (work)
+    std::vector<lid_t> ownedCell;    ///< ownedCells()
   };
 
  private:

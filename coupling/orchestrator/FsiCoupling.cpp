@@ -39,11 +39,10 @@ void copySegmentToDevice(const InterfaceVector& x, Eigen::Index offset, const Re
 
 FsiCoupling::FsiCoupling(const CouplingOptions& options, const SceneConfig& section, HexMesh& mesh, Timers& timers,
                          std::unique_ptr<FluidModule> fluid, std::vector<std::unique_ptr<MembraneModule>> membranes,
-                         std::unique_ptr<RigidModule> rigid, const HexMesh* whole, const RankDomain* domain)
+                         std::unique_ptr<RigidModule> rigid, const RankDomain* domain)
     : Module("coupling"),
       options_(options),
       mesh_(mesh),
-      whole_(whole != nullptr ? *whole : mesh),
       domain_(domain != nullptr ? *domain : RankDomain{}),
       comm_(domain != nullptr && domain->distributed() ? domain->comm : MPI_COMM_NULL),
       timers_(timers),
@@ -68,12 +67,11 @@ FsiCoupling::FsiCoupling(const CouplingOptions& options, const SceneConfig& sect
     MFSI_CHECK(m->fluidSurface() != nullptr, "coupling: " << m->name() << " keeps no fluid surface");
     const FluidSurfaceMembraneInput& surf = *m->fluidSurface();
     const MembraneMesh& mm = m->solver().mesh();
-    MFSI_CHECK(static_cast<lid_t>(surf.fluidNode.size()) == mm.nNodes() &&
-                   static_cast<lid_t>(surf.masterFace.size()) == mm.nElements(),
+    MFSI_CHECK(static_cast<lid_t>(surf.fluidNode.size()) == mm.nNodes() && surf.nElements() == mm.nElements(),
                "coupling: " << m->name() << "'s mesh does not match its fluid surface");
     const bool baffle = po.mesh.kind == MembraneMeshKind::Baffle;
     const std::string surface = baffle ? po.mesh.baffle : po.mesh.patch;
-    p.surface = coupling::SurfaceGather(whole_, mesh_, comm_, surf, surface,
+    p.surface = coupling::SurfaceGather(mesh_, comm_, surf, surface,
                                         baffle ? coupling::InterfaceSide::Baffle : coupling::InterfaceSide::Patch);
     p.iface = p.surface.gatheredInterface();
     if (comm_ != MPI_COMM_NULL) p.owner = p.surface.ownerRank();
@@ -144,9 +142,8 @@ FsiCoupling::FsiCoupling(const CouplingOptions& options, const SceneConfig& sect
   }
   if (options_.motion.distanceExponent > 0) {
     std::vector<std::array<real, 3>> moving;
-    auto X = Kokkos::create_mirror_view_and_copy(HostSpace(), whole_.referencePoints());
-    for (const Panel& p : panels_)
-      for (lid_t v : p.module->fluidSurface()->fluidNode) moving.push_back({X(v, 0), X(v, 1), X(v, 2)});
+    for (const Panel& p : panels_)  // the surface's points: the fluid nodes' reference positions
+      for (const auto& x : p.module->fluidSurface()->mesh.points) moving.push_back(x);
     for (const CoupledBody& b : bodies_)
       for (const auto& x : b.motion.allReferencePoints()) moving.push_back(x);
     smoother_->setMovingNodes(moving);
@@ -154,9 +151,9 @@ FsiCoupling::FsiCoupling(const CouplingOptions& options, const SceneConfig& sect
   if (options_.motion.columns) {
     if (comm_ != MPI_COMM_NULL)
       throw InputError(section.where("meshMotion.columns"), "columns run on one rank only");
-    std::vector<lid_t> feet;
+    std::vector<lid_t> feet;  // one rank: a node's global id is its index
     for (const Panel& p : panels_)
-      for (lid_t v : p.module->fluidSurface()->fluidNode) feet.push_back(v);
+      for (gid_t v : p.module->fluidSurface()->fluidNode) feet.push_back(static_cast<lid_t>(v));
     if (smoother_->setColumnFeet(feet) == 0)
       throw InputError(section.where("meshMotion.columns"),
                        "no column of cell edges leaves the membranes' nodes (a membrane on a boundary patch of a "
@@ -217,17 +214,14 @@ void FsiCoupling::setUpChamber(const SceneConfig& section) {
   for (const auto& [name, bc] : f.options().boundaries)
     if (bc.type == fluid::BoundaryType::FixedPressure || bc.type == fluid::BoundaryType::Resistance)
       pressure.push_back(name);
-  const coupling::ChamberRegions regions = coupling::findChamberRegions(whole_, pressure);
+  const coupling::ChamberRegions regions = coupling::findChamberRegions(mesh_, pressure, domain_);
   const long long nClosed = std::count(regions.closed.begin(), regions.closed.end(), char(1));
   if (nClosed == 0) return;
   // A closed region beside open ones: the fluid pins its pressure level and checks its balance.
   auto registerRegion = [&](int r) {
-    auto gid = Kokkos::create_mirror_view_and_copy(HostSpace(), mesh_.cellGlobalIds());
     std::vector<char> local(static_cast<std::size_t>(mesh_.nCells()));
-    for (lid_t c = 0; c < mesh_.nCells(); ++c) local[c] = regions.cellRegion[static_cast<std::size_t>(gid(c))] == r;
-    lid_t reference = 0;
-    while (regions.cellRegion[reference] != r) ++reference;
-    return f.addClosedRegion(local, reference);
+    for (lid_t c = 0; c < mesh_.nCells(); ++c) local[c] = regions.cellRegion[static_cast<std::size_t>(c)] == r;
+    return f.addClosedRegion(local, regions.firstCell[static_cast<std::size_t>(r)]);
   };
   if (!options_.volumeConstraint) {
     // Plain Dirichlet-Neumann coupling: an iterate whose volume misses the inflow then stops the
@@ -253,19 +247,20 @@ void FsiCoupling::setUpChamber(const SceneConfig& section) {
   // The membrane sides that bound the region: a patch's fluid side, a baffle's master side (the
   // region grows along the membrane normal) or slave side (it shrinks). A baffle with fluid of the
   // region on both sides sweeps no net volume of it.
-  auto own = Kokkos::create_mirror_view_and_copy(HostSpace(), whole_.faceOwner());
-  auto sideIn = [&](const std::vector<lid_t>& faces) {
-    int inside = 0;
-    for (lid_t face : faces) inside += regions.cellRegion[own(face)] == region ? 1 : 0;
-    if (inside != 0 && inside != static_cast<int>(faces.size()))
+  // Each element's cell is owned by one rank, which counts it.
+  auto sideIn = [&](const Panel& p, int side) {
+    const std::vector<lid_t>& cell = p.surface.ownedCells(side);
+    long long count[2] = {0, static_cast<long long>(cell.size())};  // inside, elements
+    for (lid_t c : cell) count[0] += c >= 0 && regions.cellRegion[static_cast<std::size_t>(c)] == region ? 1 : 0;
+    if (comm_ != MPI_COMM_NULL) MPI_Allreduce(MPI_IN_PLACE, count, 1, MPI_LONG_LONG, MPI_SUM, comm_);
+    if (count[0] != 0 && count[0] != count[1])
       throw InputError(where, "a membrane side lies partly in a closed fluid region: not supported");
-    return inside > 0;
+    return count[0] > 0;
   };
   double sign = 0;
   for (std::size_t i = 0; i < panels_.size(); ++i) {
     const Panel& p = panels_[i];
-    const FluidSurfaceMembraneInput& surf = *p.module->fluidSurface();
-    const bool front = sideIn(surf.masterFace), back = !surf.slaveFace.empty() && sideIn(surf.slaveFace);
+    const bool front = sideIn(p, 0), back = p.surface.sides() == 2 && sideIn(p, 1);
     if (front == back) continue;
     if (chamber_.panel >= 0)
       throw InputError(where, "a closed fluid region is bounded by two membranes (" +
@@ -448,10 +443,10 @@ void FsiCoupling::addOutputFields(io::FieldFrame& frame) {
   // each rank fills in the nodes it owns and zeros elsewhere, and one sum gives rank 0 every node
   // exactly (each node has one owner): no rank gathers the mesh.
   std::vector<double> points;                   // this rank's mesh points, read once
-  std::unordered_map<gid_t, std::size_t> owned;  // whole-mesh node -> this rank's owned node
+  std::unordered_map<gid_t, std::size_t> owned;  // global node id -> this rank's owned node
   for (const Panel& p : panels_) {
     if (!p.mounted) continue;
-    const std::vector<lid_t>& node = p.module->fluidSurface()->fluidNode;  // whole-mesh nodes
+    const std::vector<gid_t>& node = p.module->fluidSurface()->fluidNode;  // global node ids
     if (points.empty()) {
       points = io::hostValues(mesh_.points(), static_cast<std::size_t>(mesh_.nNodes()));
       if (comm_ != MPI_COMM_NULL) {
@@ -463,7 +458,7 @@ void FsiCoupling::addOutputFields(io::FieldFrame& frame) {
     for (std::size_t i = 0; i < node.size(); ++i) {
       std::size_t at = static_cast<std::size_t>(node[i]);
       if (comm_ != MPI_COMM_NULL) {
-        const auto it = owned.find(static_cast<gid_t>(node[i]));
+        const auto it = owned.find(node[i]);
         if (it == owned.end()) continue;
         at = it->second;
       }
@@ -1113,8 +1108,7 @@ ModuleEntry couplingModuleEntry() {
             *ctx.built = std::move(rest);
             if (!fluid) throw InputError(section.where(), "the coupling needs the scene's 'fluid' section");
             out.push_back(std::make_unique<FsiCoupling>(options, section, *ctx.mesh, *ctx.timers, std::move(fluid),
-                                                        std::move(membranes), std::move(rigid), ctx.wholeMesh,
-                                                        ctx.domain));
+                                                        std::move(membranes), std::move(rigid), ctx.domain));
             return out;
           }};
 }

@@ -60,15 +60,14 @@ class FsiCoupling final : public Module {
   /// naming the section for membranes that are not on the fluid mesh, unknown bodies or patches, or
   /// fluid walls that cannot follow them.
   ///
-  /// On several ranks `mesh` is this rank's part, `domain` names the others and `whole` is the
-  /// whole mesh, from which every rank cut the same membranes: each rank solves every membrane
-  /// and body on the same gathered loads (coupling/interface/SurfaceGather), so the interface
+  /// On several ranks `mesh` is this rank's part and `domain` names the others; every rank holds
+  /// the same membranes (each cut by the rank that holds it: structure/membrane/MembraneOnRanks)
+  /// and bodies, on the same gathered loads (coupling/interface/SurfaceGather), so the interface
   /// vectors, residuals and accelerations are the same on every rank without further messages;
   /// the mesh motion and the fluid run on the parts.
   FsiCoupling(const CouplingOptions& options, const SceneConfig& section, HexMesh& mesh, Timers& timers,
               std::unique_ptr<FluidModule> fluid, std::vector<std::unique_ptr<MembraneModule>> membranes,
-              std::unique_ptr<RigidModule> rigid = nullptr, const HexMesh* whole = nullptr,
-              const RankDomain* domain = nullptr);
+              std::unique_ptr<RigidModule> rigid = nullptr, const RankDomain* domain = nullptr);
 
   void advance(const TimeState& t) override;
 
@@ -204,7 +203,6 @@ class FsiCoupling final : public Module {
 
   CouplingOptions options_;
   HexMesh& mesh_;
-  const HexMesh& whole_;  ///< the whole mesh (mesh_ itself on one rank)
   RankDomain domain_;     ///< the other ranks' parts (none on one rank)
   MPI_Comm comm_ = MPI_COMM_NULL;  ///< several ranks: the ranks
   int rank_ = 0;                    ///< this rank in comm_ (0 on one rank)

@@ -4,6 +4,7 @@
 
 #include "core/Suggest.hpp"
 #include "structure/membrane/MembraneMeshImport.hpp"
+#include "structure/membrane/MembraneOnRanks.hpp"
 
 #include <filesystem>
 
@@ -238,7 +239,7 @@ MembraneElementType elementType(const SceneConfig& c) {
   return c.get<std::string>("elements") == "triangles" ? MembraneElementType::Tri3 : MembraneElementType::Quad4;
 }
 
-MembraneMeshSpec readMesh(const SceneConfig& m, const HexMesh* fluidMesh) {
+MembraneMeshSpec readMesh(const SceneConfig& m, const HexMesh* fluidMesh, MPI_Comm fluidComm) {
   std::vector<std::string> given;
   for (const auto& k : {"rectangle", "disc", "annulus", "sphere", "gmsh", "baffles", "boundaryPatch"})
     if (m.has(k)) given.push_back(k);
@@ -271,6 +272,9 @@ MembraneMeshSpec readMesh(const SceneConfig& m, const HexMesh* fluidMesh) {
       throw InputError(c.where("patch"), "the fluid mesh has no baffle '" + s.baffle + "'" + didYouMean(s.baffle, names) +
                                              "; baffles: " + (names.empty() ? std::string("none") : joinList(names)));
     }
+    if (fluidComm != MPI_COMM_NULL)
+      s.surface = std::make_shared<const FluidSurfaceMembraneInput>(
+          cutMembraneOnRanks(*fluidMesh, {s.baffle, true}, fluidComm));
     return s;
   }
   if (g == "boundaryPatch") {
@@ -286,6 +290,9 @@ MembraneMeshSpec readMesh(const SceneConfig& m, const HexMesh* fluidMesh) {
     if (pi < 0 || std::find(names.begin(), names.end(), s.patch) == names.end())
       throw InputError(c.where("patch"), "the fluid mesh has no one-sided boundary patch '" + s.patch + "'" +
                                              didYouMean(s.patch, names) + "; patches: " + joinList(names));
+    if (fluidComm != MPI_COMM_NULL)
+      s.surface = std::make_shared<const FluidSurfaceMembraneInput>(
+          cutMembraneOnRanks(*fluidMesh, {s.patch, false}, fluidComm));
     return s;
   }
   if (g == "rectangle") {
@@ -392,12 +399,13 @@ MembraneBoundarySpec readBoundary(const SceneConfig& b, const std::vector<std::s
   return s;
 }
 
-MembranePanelOptions readPanel(const SceneConfig& p, std::size_t index, std::size_t count, const HexMesh* fluidMesh) {
+MembranePanelOptions readPanel(const SceneConfig& p, std::size_t index, std::size_t count, const HexMesh* fluidMesh,
+                               MPI_Comm fluidComm) {
   MembranePanelOptions o;
   const std::string name = p.get<std::string>("name");
   if (name.find('.') != std::string::npos) throw InputError(p.where("name"), "panel names contain no '.'");
   o.name = !name.empty() ? "membrane." + name : count == 1 ? "membrane" : "membrane." + std::to_string(index);
-  o.mesh = readMesh(p.child("mesh"), fluidMesh);
+  o.mesh = readMesh(p.child("mesh"), fluidMesh, fluidComm);
 
   MembraneOptions& opt = o.options;
   opt.material.youngsModulus = p.get<double>("material.E");
@@ -523,9 +531,9 @@ MembraneMeshInput generateMembraneMesh(const MembraneMeshSpec& spec) {
     case MembraneMeshKind::Gmsh:
       return readGmshSurface(spec.gmshFile, spec.gmshGroup);
     case MembraneMeshKind::Baffle:
-      return membraneMeshFromBaffle(*spec.fluidMesh, spec.baffle).mesh;
+      return spec.surface ? spec.surface->mesh : membraneMeshFromBaffle(*spec.fluidMesh, spec.baffle).mesh;
     case MembraneMeshKind::Patch:
-      return membraneMeshFromPatch(*spec.fluidMesh, spec.patch).mesh;
+      return spec.surface ? spec.surface->mesh : membraneMeshFromPatch(*spec.fluidMesh, spec.patch).mesh;
   }
   return {};
 }
@@ -587,12 +595,13 @@ Schema membraneSchema() {
   return Schema::list("membrane panels, each with its own mesh, material, loads and boundary", panelSchema(), 1);
 }
 
-std::vector<MembranePanelOptions> readMembraneOptions(const SceneConfig& membranes, const HexMesh* fluidMesh) {
+std::vector<MembranePanelOptions> readMembraneOptions(const SceneConfig& membranes, const HexMesh* fluidMesh,
+                                                      MPI_Comm fluidComm) {
   std::vector<MembranePanelOptions> panels;
   const std::size_t n = membranes.size();
   for (std::size_t i = 0; i < n; ++i) {
     const SceneConfig p = membranes.child(std::to_string(i));
-    panels.push_back(readPanel(p, i, n, fluidMesh));
+    panels.push_back(readPanel(p, i, n, fluidMesh, fluidComm));
     for (std::size_t j = 0; j + 1 < panels.size(); ++j)
       if (panels[j].name == panels.back().name)
         throw InputError(p.where("name"), "two panels named '" + panels.back().name + "'");

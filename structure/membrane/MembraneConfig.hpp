@@ -21,6 +21,9 @@
 #include "structure/membrane/MembraneMesh.hpp"
 #include "structure/membrane/MembraneOptions.hpp"
 
+#include <mpi.h>
+
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -28,6 +31,8 @@ namespace mfsi {
 
 /// Mesh generator of a panel.
 enum class MembraneMeshKind { Rectangle, Disc, Annulus, Sphere, Gmsh, Baffle, Patch };
+
+struct FluidSurfaceMembraneInput;  // structure/membrane/MembraneMeshImport
 
 /// \brief Which generator builds a panel's mesh, with its parameters (only the chosen one is used).
 struct MembraneMeshSpec {
@@ -41,6 +46,9 @@ struct MembraneMeshSpec {
   std::string baffle;         ///< Baffle: baffle name in the fluid mesh (without _master/_slave)
   std::string patch;          ///< Patch: one-sided boundary patch of the fluid mesh
   const HexMesh* fluidMesh = nullptr;  ///< Baffle, Patch: the scene's fluid mesh (not owned)
+  /// Baffle, Patch on a decomposed fluid mesh (fluidMesh: this rank's part): the surface, cut by
+  /// the rank that holds it (structure/membrane/MembraneOnRanks).
+  std::shared_ptr<const FluidSurfaceMembraneInput> surface;
 };
 
 /// \brief Host mesh description of a spec (node sets included; "boundary" and "centre" are added
@@ -144,9 +152,10 @@ Schema membraneSchema();
 /// on semantic errors (no or two mesh generators, unknown node set, duplicate name, a reference
 /// solution that does not match the panel).
 /// `fluidMesh` is the scene's fluid mesh (null without a `mesh` section); panels taken from
-/// baffles need it.
-std::vector<MembranePanelOptions> readMembraneOptions(const SceneConfig& membranes,
-                                                      const HexMesh* fluidMesh = nullptr);
+/// baffles need it. On several ranks (`fluidComm`; collective) it is this rank's part, and each
+/// panel cut from it is cut by the rank that holds its surface and sent to the others.
+std::vector<MembranePanelOptions> readMembraneOptions(const SceneConfig& membranes, const HexMesh* fluidMesh = nullptr,
+                                                      MPI_Comm fluidComm = MPI_COMM_NULL);
 
 /// \brief Hencky's coefficient C_w(nu) of w0 = C_w a (p a / (E h))^(1/3), exact for any nu in
 /// (-1, 0.5] (structure/membrane/HenckySolution.hpp). Throws InputError outside.

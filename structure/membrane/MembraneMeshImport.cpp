@@ -21,6 +21,7 @@ namespace {
 FluidSurfaceMembraneInput surfaceFromFaces(const HexMesh& mesh, lid_t first, lid_t count, const std::string& source) {
   auto faces = Kokkos::create_mirror_view_and_copy(HostSpace(), mesh.faceNodes());
   auto points = Kokkos::create_mirror_view_and_copy(HostSpace(), mesh.referencePoints());
+  auto gid = Kokkos::create_mirror_view_and_copy(HostSpace(), mesh.nodeGlobalIds());
   FluidSurfaceMembraneInput out;
   out.mesh.source = source;
   std::unordered_map<lid_t, lid_t> local;
@@ -30,13 +31,14 @@ FluidSurfaceMembraneInput surfaceFromFaces(const HexMesh& mesh, lid_t first, lid
       const lid_t g = faces(f, a);
       auto [it, inserted] = local.emplace(g, static_cast<lid_t>(out.fluidNode.size()));
       if (inserted) {
-        out.fluidNode.push_back(g);
+        out.fluidNode.push_back(gid(g));
         out.mesh.points.push_back({points(g, 0), points(g, 1), points(g, 2)});
       }
       q[a] = it->second;
     }
     out.mesh.elements.push_back(q);
     out.masterFace.push_back(f);
+    out.masterFaceNodes.push_back({gid(faces(f, 0)), gid(faces(f, 1)), gid(faces(f, 2)), gid(faces(f, 3))});
   }
   // Bounding-box side sets, for clamping the ends of a strip or the edges of a panel by name.
   std::array<real, 3> lo{1e300, 1e300, 1e300}, hi{-1e300, -1e300, -1e300};
@@ -81,8 +83,13 @@ FluidSurfaceMembraneInput membraneMeshFromBaffle(const HexMesh& mesh, const std:
                                                << " master but " << ps.size << " slave faces");
   FluidSurfaceMembraneInput out =
       surfaceFromFaces(mesh, pm.start, pm.size, mesh.source() + ": baffle '" + baffleName + "'");
-  for (lid_t f = pm.start; f < pm.start + pm.size; ++f)
-    out.slaveFace.push_back(ps.start + (f - pm.start));  // face i of one side pairs with face i of the other
+  auto faces = Kokkos::create_mirror_view_and_copy(HostSpace(), mesh.faceNodes());
+  auto gid = Kokkos::create_mirror_view_and_copy(HostSpace(), mesh.nodeGlobalIds());
+  for (lid_t f = pm.start; f < pm.start + pm.size; ++f) {
+    const lid_t s = ps.start + (f - pm.start);  // face i of one side pairs with face i of the other
+    out.slaveFace.push_back(s);
+    out.slaveFaceNodes.push_back({gid(faces(s, 0)), gid(faces(s, 1)), gid(faces(s, 2)), gid(faces(s, 3))});
+  }
   return out;
 }
 

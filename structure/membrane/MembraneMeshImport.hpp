@@ -16,9 +16,14 @@ namespace mfsi {
 /// it maps back onto the fluid mesh.
 struct FluidSurfaceMembraneInput {
   MembraneMeshInput mesh;         ///< one quad per face, in the face's node order (normal = face normal)
-  std::vector<lid_t> fluidNode;   ///< membrane node i -> fluid mesh node (size mesh.points.size())
-  std::vector<lid_t> masterFace;  ///< membrane element e -> its face: of "<name>_master", or of the patch
+  std::vector<gid_t> fluidNode;   ///< membrane node i -> fluid mesh node, by global id (size mesh.points.size())
+  /// Membrane element e -> its face in the mesh it was cut from: of "<name>_master", or of the
+  /// patch. Empty on a rank that received the surface from the rank that cut it (cutMembraneOnRanks).
+  std::vector<lid_t> masterFace;
   std::vector<lid_t> slaveFace;   ///< baffle: element e -> the paired face of "<name>_slave"; patch: empty
+  /// The same faces named by their nodes' global ids, in the face's node order: valid on every rank.
+  std::vector<std::array<gid_t, 4>> masterFaceNodes, slaveFaceNodes;
+  lid_t nElements() const { return static_cast<lid_t>(masterFaceNodes.size()); }
 };
 
 /// \brief Membrane surface from the baffle `baffleName` of `mesh` (the name without the

@@ -51,11 +51,7 @@ TEST(DistributedMotion, ACopyOfANodeTellsItsOwnerOfAFaceTheOwnerLacks) {
     cellRank.push_back(x < 0.5 && z < 0.5 ? 0 : 1);
   }
   const LocalMeshPart part = localMeshPart(whole, cellRank, 2, rank);
-  RankDomain domain;
-  domain.comm = MPI_COMM_WORLD;
-  domain.cells = part.cells;
-  domain.nodes = part.nodes;
-  domain.incompleteNode = part.incompleteNode;
+  const RankDomain domain = test::worldDomain(part);
   const HexMesh local = buildHexMesh(part.input);
   coupling::MeshSmootherOptions o = test::jacobiMotion();
   o.slidingPatches = {"bottom"};

@@ -1,5 +1,6 @@
 // Halo exchange on 2 ranks (tests/support/HaloChecks.hpp): METIS on a long thin mesh with a
-// baffle, a deliberately bad (random) partition, and the deterministic global sums.
+// baffle, a deliberately bad (random) partition, and the deterministic global sums; with them
+// (from the header) the closed-chamber regions and a membrane cut on the parts.
 #include "support/HaloChecks.hpp"
 
 using namespace mfsi;

@@ -118,7 +118,7 @@ TEST(MembraneImport, BaffleGivesMasterQuadsAndFluidNodeMap) {
   auto fx = Kokkos::create_mirror_view_and_copy(HostSpace(), fluid.referencePoints());
   auto faces = Kokkos::create_mirror_view_and_copy(HostSpace(), fluid.faceNodes());
   auto facePatch = Kokkos::create_mirror_view_and_copy(HostSpace(), fluid.facePatch());
-  std::vector<lid_t> sortedFluid = in.fluidNode;
+  std::vector<mfsi::gid_t> sortedFluid = in.fluidNode;
   std::sort(sortedFluid.begin(), sortedFluid.end());
   EXPECT_TRUE(std::adjacent_find(sortedFluid.begin(), sortedFluid.end()) == sortedFluid.end());
   for (lid_t n = 0; n < mesh.nNodes(); ++n)
@@ -133,6 +133,8 @@ TEST(MembraneImport, BaffleGivesMasterQuadsAndFluidNodeMap) {
     std::array<lid_t, 4> m, s;
     for (int a = 0; a < 4; ++a) {
       EXPECT_EQ(in.fluidNode[mesh.hostElements()[e][a]], faces(in.masterFace[e], a)) << "element " << e;
+      EXPECT_EQ(in.masterFaceNodes[e][a], faces(in.masterFace[e], a)) << "element " << e;
+      EXPECT_EQ(in.slaveFaceNodes[e][a], faces(in.slaveFace[e], a)) << "element " << e;
       m[a] = faces(in.masterFace[e], a);
       s[a] = faces(in.slaveFace[e], a);
     }

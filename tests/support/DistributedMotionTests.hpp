@@ -78,11 +78,7 @@ inline void checkDistributedMotion(const HexMeshInput& in, const std::vector<int
   const MotionRun one = runMotion(global, o, RankDomain{});
   ASSERT_GT(one.minScaledJacobian, 0.3);  // a real deformation, not a trivial one
   const LocalMeshPart part = localMeshPart(whole, cellRank, ranks, rank);
-  RankDomain domain;
-  domain.comm = MPI_COMM_WORLD;
-  domain.cells = part.cells;
-  domain.nodes = part.nodes;
-  domain.incompleteNode = part.incompleteNode;
+  const RankDomain domain = worldDomain(part);
   HexMesh local = buildHexMesh(part.input);
   const MotionRun many = runMotion(local, o, domain);
   HexMesh again = buildHexMesh(part.input);

@@ -3,9 +3,12 @@
 /// \brief The MPI halo tests, shared by tests/mpi/test_halo_np2.cpp and _np4.cpp: a field of
 /// global ids survives an exchange exactly, under METIS and under a deliberately bad partition,
 /// and global sums are bitwise the same on every rank.
+#include "core/Error.hpp"
 #include "core/parallel/Halo.hpp"
 #include "core/parallel/LocalMesh.hpp"
 #include "core/parallel/Partition.hpp"
+#include "coupling/interface/ChamberRegions.hpp"
+#include "structure/membrane/MembraneOnRanks.hpp"
 #include "kernels/Blas.hpp"
 #include "support/LocalParts.hpp"
 
@@ -92,4 +95,77 @@ inline void checkGlobalSums(const HexMeshInput& in, const std::vector<int>& cell
   EXPECT_EQ(comm.globalMax(static_cast<double>(rank)), static_cast<double>(ranks - 1));
 }
 
+
+/// The fluid regions (coupling/interface/ChamberRegions) of longBoxWithBaffle("outlet") under `cellRank`,
+/// found on each rank's part: the whole mesh's two regions (the baffle spans the box), the left one
+/// closed, numbered alike on every rank, for every cell a rank holds (owned and ghost).
+inline void checkChamberRegions(const HexMeshInput& in, const std::vector<int>& cellRank) {
+  const int ranks = worldSize(), rank = worldRank();
+  const HexMesh global = buildHexMesh(in);
+  const coupling::ChamberRegions one = coupling::findChamberRegions(global, {"outlet"});
+  ASSERT_EQ(one.count, 2);
+  EXPECT_EQ(one.closed, (std::vector<char>{1, 0})) << "the left region (cell 0's) has no outlet";
+  const LocalMeshPart part = localMeshPart(global, cellRank, ranks, rank);
+  const HexMesh local = buildHexMesh(part.input);
+  const coupling::ChamberRegions many = coupling::findChamberRegions(local, {"outlet"}, worldDomain(part));
+  EXPECT_EQ(many.count, 2) << "rank " << rank;
+  EXPECT_EQ(many.closed, one.closed) << "rank " << rank;
+  EXPECT_EQ(many.firstCell, one.firstCell) << "rank " << rank;
+  auto gid = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), local.cellGlobalIds());
+  int wrong = 0;
+  for (lid_t c = 0; c < local.nCells(); ++c)
+    wrong += many.cellRegion[static_cast<std::size_t>(c)] != one.cellRegion[static_cast<std::size_t>(gid(c))];
+  EXPECT_EQ(wrong, 0) << "rank " << rank << ": cells in another region than on the whole mesh";
+}
+
+
+/// The membrane on longBoxWithBaffle's panel cut from the ranks' parts under `cellRank` (which
+/// keeps the panel's cells on one rank): every rank gets the whole mesh's surface, bit for bit.
+inline void checkMembraneOnRanks(const HexMeshInput& in, const std::vector<int>& cellRank) {
+  const int ranks = worldSize(), rank = worldRank();
+  const HexMesh global = buildHexMesh(in);
+  const FluidSurfaceMembraneInput one = membraneMeshFromBaffle(global, "panel");
+  ASSERT_GT(one.nElements(), 0);
+  const LocalMeshPart part = localMeshPart(global, cellRank, ranks, rank);
+  const HexMesh local = buildHexMesh(part.input);
+  const FluidSurfaceMembraneInput many = cutMembraneOnRanks(local, {"panel", true}, MPI_COMM_WORLD);
+  EXPECT_EQ(many.mesh.points, one.mesh.points) << "rank " << rank;
+  EXPECT_EQ(many.mesh.elements, one.mesh.elements) << "rank " << rank;
+  EXPECT_EQ(many.mesh.nodeSets, one.mesh.nodeSets) << "rank " << rank;
+  EXPECT_EQ(many.fluidNode, one.fluidNode) << "rank " << rank;
+  EXPECT_EQ(many.masterFaceNodes, one.masterFaceNodes) << "rank " << rank;
+  EXPECT_EQ(many.slaveFaceNodes, one.slaveFaceNodes) << "rank " << rank;
+  // The faces by index only where it was cut: the rank that owns the panel's cells.
+  int cutHere = many.masterFace.empty() ? 0 : 1, cuts = 0;
+  MPI_Allreduce(&cutHere, &cuts, 1, MPI_INT, MPI_SUM, MPI_COMM_WORLD);
+  EXPECT_EQ(cuts, 1);
+}
+
+/// A partition that splits the panel's cells over ranks: the same InputError on every rank.
+inline void checkMembraneSplitOverRanks(const HexMeshInput& in, const std::vector<int>& cellRank) {
+  const HexMesh global = buildHexMesh(in);
+  const LocalMeshPart part = localMeshPart(global, cellRank, worldSize(), worldRank());
+  const HexMesh local = buildHexMesh(part.input);
+  try {
+    cutMembraneOnRanks(local, {"panel", true}, MPI_COMM_WORLD);
+    ADD_FAILURE() << "rank " << worldRank() << ": a panel split over ranks was cut";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("baffle 'panel' are owned by ranks"), std::string::npos) << e.what();
+  }
+}
+
 }  // namespace mfsi::test
+
+TEST(ChamberRegions, TheWholeMeshsRegionsOnEveryPart) {
+  using namespace mfsi;
+  const HexMeshInput in = test::longBoxWithBaffle("outlet");
+  test::checkChamberRegions(in, partitionCells(in, test::keepPanelTogether(in, test::worldSize())).cellRank);
+  test::checkChamberRegions(in, test::randomPartition(in.cells.size(), test::worldSize()));
+}
+
+TEST(MembraneOnRanks, TheOwnerCutsTheWholeMeshsSurfaceForEveryRank) {
+  using namespace mfsi;
+  const HexMeshInput in = test::longBoxWithBaffle();
+  test::checkMembraneOnRanks(in, partitionCells(in, test::keepPanelTogether(in, test::worldSize())).cellRank);
+  test::checkMembraneSplitOverRanks(in, test::randomPartition(in.cells.size(), test::worldSize()));
+}

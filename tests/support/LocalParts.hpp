@@ -3,18 +3,23 @@
 /// \brief Helpers of the decomposition tests: meshes with a baffle, and partitions good and bad.
 #include "core/BlockMesh.hpp"
 #include "core/HexMesh.hpp"
+#include "core/parallel/Halo.hpp"
+#include "core/parallel/LocalMesh.hpp"
 #include "core/parallel/Partition.hpp"
 
 #include <cmath>
 #include <random>
+#include <string>
 #include <vector>
 
 namespace mfsi::test {
 
 /// A long thin box (40 x 4 x 2 cells) with a baffle across its middle (x = 0.5), so ghosts,
-/// patches and a baffle all cross rank boundaries.
-inline HexMeshInput longBoxWithBaffle() {
+/// patches and a baffle all cross rank boundaries; with `rightEnd`, its face at x = 1 is that
+/// patch (the rest stay the default patch).
+inline HexMeshInput longBoxWithBaffle(const std::string& rightEnd = "") {
   BlockMeshSpec spec = boxSpec({0, 0, 0}, {1, 0.1, 0.05}, {40, 4, 2});
+  if (!rightEnd.empty()) spec.blocks[0].patches = {"", rightEnd, "", "", "", ""};
   BaffleRect b;
   b.name = "panel";
   b.axis = 0;
@@ -56,6 +61,16 @@ inline std::vector<int> randomPartition(std::size_t nCells, int ranks, unsigned 
   for (auto& x : r) x = pick(gen);
   for (int k = 0; k < ranks && static_cast<std::size_t>(k) < nCells; ++k) r[k] = k;  // no empty rank
   return r;
+}
+
+/// The domain of a rank's part on MPI_COMM_WORLD.
+inline RankDomain worldDomain(const LocalMeshPart& part) {
+  RankDomain domain;
+  domain.comm = MPI_COMM_WORLD;
+  domain.cells = part.cells;
+  domain.nodes = part.nodes;
+  domain.incompleteNode = part.incompleteNode;
+  return domain;
 }
 
 }  // namespace mfsi::test
