@@ -121,7 +121,8 @@ int commandCheck(const std::string& scene, const std::vector<std::string>& sets,
     const auto cfg = mfsi::SceneConfig::load(file.string(), mfsi::sceneSchema(), sets);
     mfsi::Simulation sim(cfg);
     std::cout << "ok: " << file.string() << ": scene '" << sceneName(cfg, file) << "', "
-              << (sim.hasMesh() ? sim.mesh().nCells() : 0) << " cells, " << (sim.hasMesh() ? sim.mesh().nNodes() : 0)
+              << (sim.hasMesh() ? sim.meshCounts().cells : 0) << " cells, "
+              << (sim.hasMesh() ? sim.meshCounts().nodes : 0)
               << " nodes, " << sim.modules().size() << " module(s)\n";
     return 0;
   } catch (const mfsi::InputError& e) {
@@ -244,8 +245,8 @@ int commandRun(std::string sceneArg, const std::vector<std::string>& sets, std::
     }
     sim = std::make_unique<mfsi::Simulation>(cfg, partitionMap);
     if (sim->hasMesh()) {
-      summary.cells = sim->mesh().nCells();
-      summary.nodes = sim->mesh().nNodes();
+      summary.cells = sim->meshCounts().cells;
+      summary.nodes = sim->meshCounts().nodes;
     }
     if (!checkpoint.empty()) {
       const std::vector<std::string> changes = sim->restore(checkpoint, allowChanges);

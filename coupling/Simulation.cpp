@@ -4,6 +4,7 @@
 #include "core/MeshConfig.hpp"
 #include "core/io/HostCopy.hpp"
 #include "core/parallel/LocalMesh.hpp"
+#include "core/parallel/MeshScatter.hpp"
 #include "core/parallel/Partition.hpp"
 #include "kernels/Blas.hpp"
 
@@ -11,7 +12,9 @@
 #include <cmath>
 #include <cstdio>
 #include <cstring>
+#include <exception>
 #include <filesystem>
+#include <functional>
 #include <optional>
 
 namespace mfsi {
@@ -21,6 +24,36 @@ namespace fs = std::filesystem;
 namespace {
 /// Steps a scene may ask for: a billion-step run of the smallest scene takes weeks.
 constexpr double kMaxSteps = 1e9;
+
+/// Work rank 0 alone does (it alone holds the whole mesh). When it fails, every rank fails: rank 0
+/// with its own exception, the others with an error of the same kind (input or not) and message.
+/// Collective over MPI_COMM_WORLD.
+void onRankZero(int rank, const std::function<void()>& work) {
+  std::uint64_t head[2] = {0, 0};  // 0 done, 1 an input error, 2 another failure; message length
+  std::string message;
+  std::exception_ptr failure;
+  if (rank == 0) {
+    try {
+      work();
+    } catch (const InputError& e) {
+      head[0] = 1;
+      message = e.what();
+      failure = std::current_exception();
+    } catch (const std::exception& e) {
+      head[0] = 2;
+      message = e.what();
+      failure = std::current_exception();
+    }
+    head[1] = message.size();
+  }
+  MPI_Bcast(head, 2, MPI_UINT64_T, 0, MPI_COMM_WORLD);
+  if (head[0] == 0) return;
+  message.resize(head[1]);
+  MPI_Bcast(message.data(), static_cast<int>(head[1]), MPI_CHAR, 0, MPI_COMM_WORLD);
+  if (failure) std::rethrow_exception(failure);
+  if (head[0] == 1) throw InputError(message);
+  throw std::runtime_error(message);
+}
 }  // namespace
 
 Schema sceneSchema() {
@@ -69,12 +102,27 @@ Simulation::Simulation(const SceneConfig& scene) : Simulation(scene, std::string
 
 Simulation::Simulation(const SceneConfig& scene, const std::string& partitionFile) {
   hasMesh_ = scene.has("mesh");
+  int mpiUp = 0;
+  MPI_Initialized(&mpiUp);
+  if (mpiUp) {
+    MPI_Comm_size(MPI_COMM_WORLD, &ranks_);
+    MPI_Comm_rank(MPI_COMM_WORLD, &rank_);
+  }
   if (hasMesh_) {
     ScopedTimer t(timers_, "mesh");
-    mesh_ = buildMesh(scene.child("mesh"));
-    geometry_ = allocateGeometry(mesh_);
-    computeGeometry(ExecSpace(), mesh_, geometry_);
-    Kokkos::fence();
+    if (ranks_ > 1) {  // rank 0 alone reads the mesh; decompose() hands out the parts
+      onRankZero(rank_, [&] {
+        mesh_ = buildMesh(scene.child("mesh"));
+        counts_ = MeshCounts::of(mesh_);
+      });
+      MPI_Bcast(&counts_, sizeof(MeshCounts), MPI_BYTE, 0, MPI_COMM_WORLD);
+    } else {
+      mesh_ = buildMesh(scene.child("mesh"));
+      counts_ = MeshCounts::of(mesh_);
+      geometry_ = allocateGeometry(mesh_);
+      computeGeometry(ExecSpace(), mesh_, geometry_);
+      Kokkos::fence();
+    }
   }
   time_.endTime = scene.get<double>("time.endTime");
   time_.dt = scene.get<double>("time.dt");
@@ -102,12 +150,6 @@ Simulation::Simulation(const SceneConfig& scene, const std::string& partitionFil
     nSteps_ = static_cast<long long>(steps);
   }
 
-  int mpiUp = 0;
-  MPI_Initialized(&mpiUp);
-  if (mpiUp) {
-    MPI_Comm_size(MPI_COMM_WORLD, &ranks_);
-    MPI_Comm_rank(MPI_COMM_WORLD, &rank_);
-  }
   if (ranks_ > 1) decompose(scene, partitionFile);
   else if (!partitionFile.empty() && hasMesh_)  // checked all the same: a map for more ranks is a mistake
     readPartitionMap(partitionFile, static_cast<std::size_t>(mesh_.nCells()), 1);
@@ -171,6 +213,29 @@ void Simulation::decompose(const SceneConfig& scene, const std::string& partitio
   const std::string how = " (run it on one rank: without mpirun, or mpirun -np 1; threads: --threads)";
   if (!hasMesh_) throw InputError(scene.where(), "a scene without a mesh runs on one rank" + how);
   ScopedTimer t(timers_, "decompose");
+  // Rank 0 partitions the mesh it read, and sends every rank its part.
+  std::vector<int> cellRank;
+  std::uint64_t hash = 1469598103934665603ull;  // FNV-1a over the map
+  onRankZero(rank_, [&] {
+    cellRank = partitionCells(scene, partitionFile);
+    for (int r : cellRank) hash = (hash ^ static_cast<std::uint64_t>(r)) * 1099511628211ull;
+  });
+  MPI_Bcast(&hash, 1, MPI_UINT64_T, 0, MPI_COMM_WORLD);
+  partitionHash_ = static_cast<std::int64_t>(hash >> 1);
+  const HexMesh* whole = rank_ == 0 ? &mesh_ : nullptr;
+  const LocalMeshPart lp = scatterParts(MPI_COMM_WORLD, 0, whole, cellRank);
+  localMesh_ = buildHexMesh(lp.input);
+  localGeometry_ = allocateGeometry(localMesh_);
+  computeGeometry(ExecSpace(), localMesh_, localGeometry_);
+  domain_.comm = MPI_COMM_WORLD;
+  domain_.cells = lp.cells;
+  domain_.nodes = lp.nodes;
+  domain_.incompleteNode = lp.incompleteNode;
+  partFaces_ = globalFaceIdsFromRoot(MPI_COMM_WORLD, 0, localMesh_, whole);
+  Kokkos::fence();
+}
+
+std::vector<int> Simulation::partitionCells(const SceneConfig& scene, const std::string& partitionFile) const {
   Partition part;
   if (partitionFile.empty()) {
     PartitionOptions opt;
@@ -189,18 +254,7 @@ void Simulation::decompose(const SceneConfig& scene, const std::string& partitio
                            ") and " + std::to_string(part.cellRank[c]) + " (cell " + std::to_string(c) +
                            "); a membrane's or a baffle's cells stay on one rank (mfsi partition writes such a map)");
   }
-  const LocalMeshPart lp = localMeshPart(mesh_, part.cellRank, ranks_, rank_);
-  std::uint64_t h = 1469598103934665603ull;  // FNV-1a over the map
-  for (int r : part.cellRank) h = (h ^ static_cast<std::uint64_t>(r)) * 1099511628211ull;
-  partitionHash_ = static_cast<std::int64_t>(h >> 1);
-  localMesh_ = buildHexMesh(lp.input);
-  localGeometry_ = allocateGeometry(localMesh_);
-  computeGeometry(ExecSpace(), localMesh_, localGeometry_);
-  domain_.comm = MPI_COMM_WORLD;
-  domain_.cells = lp.cells;
-  domain_.nodes = lp.nodes;
-  domain_.incompleteNode = lp.incompleteNode;
-  Kokkos::fence();
+  return part.cellRank;
 }
 
 void Simulation::meshMetrics(std::map<std::string, double>& m) const {
@@ -229,9 +283,9 @@ void Simulation::meshMetrics(std::map<std::string, double>& m) const {
   m["mesh.total_volume"] = q.totalVolume;
   m["mesh.min_cell_volume"] = q.minVolume;
   m["mesh.max_cell_volume"] = q.maxVolume;
-  m["mesh.internal_faces"] = mesh_.nInternalFaces();
-  m["mesh.boundary_faces"] = mesh_.nBoundaryFaces();
-  m["mesh.patches"] = static_cast<double>(mesh_.patches().size());
+  m["mesh.internal_faces"] = static_cast<double>(counts_.internalFaces);
+  m["mesh.boundary_faces"] = static_cast<double>(counts_.boundaryFaces);
+  m["mesh.patches"] = static_cast<double>(counts_.patches);
 }
 
 io::OutputGrid Simulation::meshGrid() const {
@@ -242,8 +296,8 @@ io::OutputGrid Simulation::meshGrid() const {
   g.name = "mesh";
   g.shape = io::CellShape::Hexahedron;
   g.decomposed = decomposed;
-  g.globalPoints = static_cast<std::size_t>(mesh_.nNodes());
-  g.globalCells = static_cast<std::size_t>(mesh_.nCells());
+  g.globalPoints = static_cast<std::size_t>(counts_.nodes);
+  g.globalCells = static_cast<std::size_t>(counts_.cells);
   const std::size_t nNodes = static_cast<std::size_t>(m.nOwnedNodes());
   const std::size_t nCells = static_cast<std::size_t>(m.nOwnedCells());
   auto nodeIds = Kokkos::create_mirror_view_and_copy(HostSpace(), m.nodeGlobalIds());  // the identity on one rank
@@ -461,7 +515,7 @@ std::string Simulation::writeCheckpoint(const std::string& outDir, const TimeSta
       mesh.putView("points", ownMesh().points(), io::Entity::Nodes);
     }
     if (ranks_ > 1 && hasMesh_) {  // what carries the state to another decomposition (restore)
-      if (!partIds_) partIds_ = io::partIds(localMesh_, mesh_);
+      if (!partIds_) partIds_ = io::partIds(localMesh_, partFaces_, counts_);
       io::StateWriter part(*file, "/run/part");
       io::writePartIds(part, *partIds_);
     }
@@ -556,9 +610,10 @@ io::Hdf5File Simulation::carryCheckpoint(const io::Hdf5File& first, const std::s
       throw InputError("--restart: '" + f->path() + "' has no global ids (/run/part): it was written before "
                        "checkpoints could move to another decomposition; continue it on " +
                        std::to_string(writtenOn) + " ranks with the same partition");
-    old.push_back(writtenOn > 1 ? io::readPartIds(io::StateReader(*f, "/run/part"), mesh_) : io::wholeMeshIds(mesh_));
+    old.push_back(writtenOn > 1 ? io::readPartIds(io::StateReader(*f, "/run/part"), counts_)
+                                : io::wholeMeshIds(counts_));
   }
-  const io::PartIds mine = ranks_ > 1 ? io::partIds(localMesh_, mesh_) : io::wholeMeshIds(mesh_);
+  const io::PartIds mine = ranks_ > 1 ? io::partIds(localMesh_, partFaces_, counts_) : io::wholeMeshIds(counts_);
   io::Hdf5File carried = io::Hdf5File::scratch(checkpointFile + " (carried to rank " + std::to_string(rank_) +
                                                " of " + std::to_string(ranks_) + ")");
   io::redistribute(parts, old, mine, carried);
@@ -571,10 +626,14 @@ void Simulation::restorePoints(const io::Hdf5File& first, const io::Hdf5File& st
     return;
   }
   // A checkpoint written before its parts held their points: rank 0's file has the whole mesh's
-  // (read into mesh_, which on several ranks moves only here).
-  io::StateReader(first, "/mesh").getView("points", mesh_.points());
-  if (ranks_ == 1) return;
-  auto whole = Kokkos::create_mirror_view_and_copy(HostSpace(), mesh_.points());
+  // (every rank reads them and keeps its own).
+  if (ranks_ == 1) {
+    io::StateReader(first, "/mesh").getView("points", mesh_.points());
+    return;
+  }
+  Real3View all("mfsi::run::checkpointPoints", static_cast<std::size_t>(counts_.nodes));
+  io::StateReader(first, "/mesh").getView("points", all);
+  auto whole = Kokkos::create_mirror_view_and_copy(HostSpace(), all);
   auto gid = Kokkos::create_mirror_view_and_copy(HostSpace(), localMesh_.nodeGlobalIds());
   auto x = Kokkos::create_mirror_view(localMesh_.points());
   for (lid_t i = 0; i < localMesh_.nNodes(); ++i)

@@ -94,9 +94,11 @@ class Simulation {
   /// Ranks of MPI_COMM_WORLD the run is decomposed over (1: the whole mesh here), and this one.
   int ranks() const { return ranks_; }
   int rank() const { return rank_; }
-  /// The scene's whole mesh: on one rank the mesh the run moves, on several as it was read (each
-  /// rank moves its own part).
+  /// The scene's whole mesh: on one rank the mesh the run moves; on several, rank 0's as it read
+  /// it (each rank moves its own part) and empty on the others (meshCounts() holds its sizes).
   const HexMesh& mesh() const { return mesh_; }
+  /// The sizes of the whole mesh, on every rank.
+  const MeshCounts& meshCounts() const { return counts_; }
   const std::vector<std::unique_ptr<Module>>& modules() const { return modules_; }
   Timers& timers() { return timers_; }
   const TimeOptions& timeOptions() const { return time_; }
@@ -127,9 +129,12 @@ class Simulation {
   /// The scene mesh's grid of a frame; on several ranks this rank's part (its owned points and cells).
   io::OutputGrid meshGrid() const;
 
-  /// Build this rank's part of mesh_ (METIS over the ranks, each membrane's cells on one rank);
-  /// throws InputError for what does not run on several ranks yet.
+  /// Build this rank's part of the mesh: rank 0 partitions the mesh it read (METIS over the ranks,
+  /// each membrane's cells on one rank, or the partition file) and sends every rank its part;
+  /// throws InputError (on every rank) for what does not run on several ranks yet.
   void decompose(const SceneConfig& scene, const std::string& partitionFile);
+  /// Rank 0: the rank of every cell of mesh_.
+  std::vector<int> partitionCells(const SceneConfig& scene, const std::string& partitionFile) const;
   /// The mesh this rank computes on and its geometry: its part on several ranks, else the whole mesh.
   HexMesh& ownMesh() { return ranks_ > 1 ? localMesh_ : mesh_; }
   const HexMesh& ownMesh() const { return ranks_ > 1 ? localMesh_ : mesh_; }
@@ -141,7 +146,8 @@ class Simulation {
 
   Timers timers_;
   bool hasMesh_ = false;
-  HexMesh mesh_;  ///< the whole mesh (every rank builds it; on several ranks only the parts move)
+  HexMesh mesh_;  ///< the whole mesh (on several ranks: rank 0's, to hand out the parts; it never moves)
+  MeshCounts counts_;  ///< the whole mesh's sizes, on every rank
   MeshGeometry geometry_;
   /// On several ranks: this rank's part of mesh_, its geometry, and the ranks it talks to.
   int ranks_ = 1, rank_ = 0;
@@ -151,6 +157,7 @@ class Simulation {
   int carriedFromRanks_ = 0;
   /// Several ranks: this rank's global ids, as its checkpoints record them (made at the first one).
   std::optional<io::PartIds> partIds_;
+  std::vector<std::int64_t> partFaces_;  ///< several ranks: the global face of each of the part's faces
   std::int64_t partitionHash_ = 0;  ///< several ranks: a hash of the cell -> rank map (checkpoints hold it)
   TimeOptions time_;
   long long nSteps_ = 0;  ///< from time_ (checked at set-up)

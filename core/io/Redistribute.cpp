@@ -9,12 +9,18 @@
 namespace mfsi::io {
 
 PartIds partIds(const HexMesh& part, const HexMesh& global) {
+  return partIds(part, globalFaceIds(part, global), MeshCounts::of(global));
+}
+
+PartIds partIds(const HexMesh& part, const std::vector<std::int64_t>& globalFaces, const MeshCounts& global) {
   PartIds ids;
   auto cells = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), part.cellGlobalIds());
   auto nodes = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), part.nodeGlobalIds());
   ids.cells.assign(cells.data(), cells.data() + cells.extent(0));
   ids.nodes.assign(nodes.data(), nodes.data() + nodes.extent(0));
-  ids.faces = globalFaceIds(part, global);
+  MFSI_CHECK(static_cast<lid_t>(globalFaces.size()) == part.nFaces(),
+             "partIds: " << globalFaces.size() << " global faces for " << part.nFaces() << " faces");
+  ids.faces = globalFaces;
   // A face is written by the rank that owns its global owner cell: the local owner when the face
   // points the global way, else the local neighbour (a processor face's other cell is elsewhere).
   auto own = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), part.faceOwner());
@@ -28,10 +34,10 @@ PartIds partIds(const HexMesh& part, const HexMesh& global) {
   ids.ownedCells = part.nOwnedCells();
   ids.ownedNodes = part.nOwnedNodes();
   ids.internalFaces = part.nInternalFaces();
-  ids.globalCells = global.nCells();
-  ids.globalNodes = global.nNodes();
-  ids.globalFaces = global.nFaces();
-  ids.globalInternalFaces = global.nInternalFaces();
+  ids.globalCells = global.cells;
+  ids.globalNodes = global.nodes;
+  ids.globalFaces = global.faces;
+  ids.globalInternalFaces = global.internalFaces;
   return ids;
 }
 
@@ -44,12 +50,12 @@ void writePartIds(StateWriter& w, const PartIds& ids) {
                                             ids.globalNodes, ids.globalFaces, ids.globalInternalFaces});
 }
 
-PartIds wholeMeshIds(const HexMesh& global) {
+PartIds wholeMeshIds(const MeshCounts& global) {
   PartIds ids;
-  ids.globalCells = ids.ownedCells = global.nCells();
-  ids.globalNodes = ids.ownedNodes = global.nNodes();
-  ids.globalFaces = global.nFaces();
-  ids.globalInternalFaces = ids.internalFaces = global.nInternalFaces();
+  ids.globalCells = ids.ownedCells = global.cells;
+  ids.globalNodes = ids.ownedNodes = global.nodes;
+  ids.globalFaces = global.faces;
+  ids.globalInternalFaces = ids.internalFaces = global.internalFaces;
   for (long long c = 0; c < ids.globalCells; ++c) ids.cells.push_back(c);
   for (long long n = 0; n < ids.globalNodes; ++n) ids.nodes.push_back(n);
   for (long long f = 0; f < ids.globalFaces; ++f) ids.faces.push_back(f);
@@ -57,12 +63,12 @@ PartIds wholeMeshIds(const HexMesh& global) {
   return ids;
 }
 
-PartIds readPartIds(const StateReader& r, const HexMesh& global) {
+PartIds readPartIds(const StateReader& r, const MeshCounts& global) {
   PartIds ids;
-  ids.globalCells = global.nCells();
-  ids.globalNodes = global.nNodes();
-  ids.globalFaces = global.nFaces();
-  ids.globalInternalFaces = global.nInternalFaces();
+  ids.globalCells = global.cells;
+  ids.globalNodes = global.nodes;
+  ids.globalFaces = global.faces;
+  ids.globalInternalFaces = global.internalFaces;
   const auto counts = r.ints("counts", 7);
   const long long expected[] = {ids.globalCells, ids.globalNodes, ids.globalFaces, ids.globalInternalFaces};
   for (int k = 0; k < 4; ++k)

@@ -20,6 +20,7 @@
 #include "core/HexMesh.hpp"
 #include "core/io/Checkpoint.hpp"
 #include "core/io/Hdf5File.hpp"
+#include "core/parallel/MeshScatter.hpp"
 
 #include <cstdint>
 #include <vector>
@@ -42,11 +43,15 @@ struct PartIds {
 
 /// The ids of `part` (a rank's part of `global`, or `global` itself on one rank).
 PartIds partIds(const HexMesh& part, const HexMesh& global);
+/// The same from the global face of each of the part's faces (globalFaceIds) and the whole mesh's
+/// counts: what a rank without the whole mesh knows.
+PartIds partIds(const HexMesh& part, const std::vector<std::int64_t>& globalFaces, const MeshCounts& global);
 /// The ids of the whole mesh as one rank's part (the identity): a one-rank run's checkpoint.
-PartIds wholeMeshIds(const HexMesh& global);
+PartIds wholeMeshIds(const MeshCounts& global);
+inline PartIds wholeMeshIds(const HexMesh& global) { return wholeMeshIds(MeshCounts::of(global)); }
 /// Write / read PartIds under a group ("/run/part"); reading checks them against `global`'s sizes.
 void writePartIds(StateWriter& w, const PartIds& ids);
-PartIds readPartIds(const StateReader& r, const HexMesh& global);
+PartIds readPartIds(const StateReader& r, const MeshCounts& global);
 
 /// \brief Build in `out` every dataset under "/modules", and every tagged one under "/mesh" (the
 /// moved points), of the part `mine` from the checkpoint in

@@ -236,7 +236,23 @@ FaceKey faceKey(const Quads& fn, lid_t f, const Gids& nodeGid) {
 }
 }  // namespace
 
-std::vector<std::int64_t> globalFaceIds(const HexMesh& part, const HexMesh& global) {
+std::vector<gid_t> faceKeys(const HexMesh& part) {
+  const auto pfn = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), part.faceNodes());
+  const auto pown = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), part.faceOwner());
+  const auto pnid = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), part.nodeGlobalIds());
+  const auto pcid = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), part.cellGlobalIds());
+  std::vector<gid_t> keys;
+  keys.reserve(static_cast<std::size_t>(part.nFaces()) * 5);
+  for (lid_t f = 0; f < part.nFaces(); ++f) {
+    const FaceKey k = faceKey(pfn, f, pnid);
+    keys.insert(keys.end(), k.begin(), k.end());
+    keys.push_back(pcid(pown(f)));
+  }
+  return keys;
+}
+
+std::vector<std::int64_t> globalFaceIdsOfKeys(const HexMesh& global, const std::vector<gid_t>& keys,
+                                              const std::string& what) {
   const auto gfn = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), global.faceNodes());
   const auto gown = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), global.faceOwner());
   const auto gnid = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), global.nodeGlobalIds());
@@ -248,21 +264,22 @@ std::vector<std::int64_t> globalFaceIds(const HexMesh& part, const HexMesh& glob
     auto [it, fresh] = byNodes.try_emplace(faceKey(gfn, f, gnid), std::array<lid_t, 2>{f, -1});
     if (!fresh) it->second[1] = f;
   }
-  const auto pfn = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), part.faceNodes());
-  const auto pown = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), part.faceOwner());
-  const auto pnid = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), part.nodeGlobalIds());
-  const auto pcid = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), part.cellGlobalIds());
-  std::vector<std::int64_t> ids(static_cast<std::size_t>(part.nFaces()));
-  for (lid_t f = 0; f < part.nFaces(); ++f) {
-    const auto it = byNodes.find(faceKey(pfn, f, pnid));
-    MFSI_CHECK(it != byNodes.end(), "globalFaceIds: face " << f << " of " << part.source() << " is not in "
-                                                           << global.source());
-    const gid_t owner = pcid(pown(f));
+  const std::size_t n = keys.size() / 5;
+  std::vector<std::int64_t> ids(n);
+  for (std::size_t f = 0; f < n; ++f) {
+    const FaceKey k{keys[5 * f], keys[5 * f + 1], keys[5 * f + 2], keys[5 * f + 3]};
+    const auto it = byNodes.find(k);
+    MFSI_CHECK(it != byNodes.end(), "globalFaceIds: face " << f << " of " << what << " is not in " << global.source());
+    const gid_t owner = keys[5 * f + 4];
     lid_t g = it->second[0];
     if (it->second[1] >= 0 && gcid(gown(g)) != owner) g = it->second[1];  // the baffle's other side
     ids[f] = gcid(gown(g)) == owner ? g : -(static_cast<std::int64_t>(g) + 1);
   }
   return ids;
+}
+
+std::vector<std::int64_t> globalFaceIds(const HexMesh& part, const HexMesh& global) {
+  return globalFaceIdsOfKeys(global, faceKeys(part), part.source());
 }
 
 }  // namespace mfsi

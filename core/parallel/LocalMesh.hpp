@@ -57,4 +57,11 @@ LocalMeshPart localMeshPart(const HexMesh& global, const std::vector<int>& cellR
 /// cell. Matched by the faces' global node ids, on the host.
 std::vector<std::int64_t> globalFaceIds(const HexMesh& part, const HexMesh& global);
 
+/// \brief What names each face of `part` for globalFaceIdsOfKeys: its nodes' global ids (sorted)
+/// and its owner cell's global id, 5 values per face.
+std::vector<gid_t> faceKeys(const HexMesh& part);
+/// \brief globalFaceIds of faces given by their keys (`what` names them in messages).
+std::vector<std::int64_t> globalFaceIdsOfKeys(const HexMesh& global, const std::vector<gid_t>& keys,
+                                              const std::string& what);
+
 }  // namespace mfsi
