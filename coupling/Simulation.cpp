@@ -232,6 +232,7 @@ void Simulation::decompose(const SceneConfig& scene, const std::string& partitio
   domain_.nodes = lp.nodes;
   domain_.incompleteNode = lp.incompleteNode;
   partFaces_ = globalFaceIdsFromRoot(MPI_COMM_WORLD, 0, localMesh_, whole);
+  mesh_ = HexMesh();  // rank 0's whole mesh is not needed past this point
   Kokkos::fence();
 }
 

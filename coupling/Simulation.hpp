@@ -94,8 +94,8 @@ class Simulation {
   /// Ranks of MPI_COMM_WORLD the run is decomposed over (1: the whole mesh here), and this one.
   int ranks() const { return ranks_; }
   int rank() const { return rank_; }
-  /// The scene's whole mesh: on one rank the mesh the run moves; on several, rank 0's as it read
-  /// it (each rank moves its own part) and empty on the others (meshCounts() holds its sizes).
+  /// The scene's whole mesh: on one rank the mesh the run moves; on several, empty (rank 0 reads
+  /// it and frees it once it has handed out the parts; meshCounts() holds its sizes).
   const HexMesh& mesh() const { return mesh_; }
   /// The sizes of the whole mesh, on every rank.
   const MeshCounts& meshCounts() const { return counts_; }
@@ -146,7 +146,7 @@ class Simulation {
 
   Timers timers_;
   bool hasMesh_ = false;
-  HexMesh mesh_;  ///< the whole mesh (on several ranks: rank 0's, to hand out the parts; it never moves)
+  HexMesh mesh_;  ///< the whole mesh (on several ranks: rank 0's while it hands out the parts, then empty)
   MeshCounts counts_;  ///< the whole mesh's sizes, on every rank
   MeshGeometry geometry_;
   /// On several ranks: this rank's part of mesh_, its geometry, and the ranks it talks to.
