@@ -3,6 +3,7 @@
 #include "core/Interrupt.hpp"
 #include "core/MeshConfig.hpp"
 #include "core/io/HostCopy.hpp"
+#include "core/parallel/FailureAgreement.hpp"
 #include "core/parallel/LocalMesh.hpp"
 #include "core/parallel/MeshScatter.hpp"
 #include "core/parallel/Partition.hpp"
@@ -12,9 +13,7 @@
 #include <cmath>
 #include <cstdio>
 #include <cstring>
-#include <exception>
 #include <filesystem>
-#include <functional>
 #include <optional>
 
 namespace mfsi {
@@ -24,36 +23,6 @@ namespace fs = std::filesystem;
 namespace {
 /// Steps a scene may ask for: a billion-step run of the smallest scene takes weeks.
 constexpr double kMaxSteps = 1e9;
-
-/// Work rank 0 alone does (it alone holds the whole mesh). When it fails, every rank fails: rank 0
-/// with its own exception, the others with an error of the same kind (input or not) and message.
-/// Collective over MPI_COMM_WORLD.
-void onRankZero(int rank, const std::function<void()>& work) {
-  std::uint64_t head[2] = {0, 0};  // 0 done, 1 an input error, 2 another failure; message length
-  std::string message;
-  std::exception_ptr failure;
-  if (rank == 0) {
-    try {
-      work();
-    } catch (const InputError& e) {
-      head[0] = 1;
-      message = e.what();
-      failure = std::current_exception();
-    } catch (const std::exception& e) {
-      head[0] = 2;
-      message = e.what();
-      failure = std::current_exception();
-    }
-    head[1] = message.size();
-  }
-  MPI_Bcast(head, 2, MPI_UINT64_T, 0, MPI_COMM_WORLD);
-  if (head[0] == 0) return;
-  message.resize(head[1]);
-  MPI_Bcast(message.data(), static_cast<int>(head[1]), MPI_CHAR, 0, MPI_COMM_WORLD);
-  if (failure) std::rethrow_exception(failure);
-  if (head[0] == 1) throw InputError(message);
-  throw std::runtime_error(message);
-}
 }  // namespace
 
 Schema sceneSchema() {
@@ -111,7 +80,7 @@ Simulation::Simulation(const SceneConfig& scene, const std::string& partitionFil
   if (hasMesh_) {
     ScopedTimer t(timers_, "mesh");
     if (ranks_ > 1) {  // rank 0 alone reads the mesh; decompose() hands out the parts
-      onRankZero(rank_, [&] {
+      runOnOneRank(MPI_COMM_WORLD, 0, [&] {
         mesh_ = buildMesh(scene.child("mesh"));
         counts_ = MeshCounts::of(mesh_);
       });
@@ -216,7 +185,7 @@ void Simulation::decompose(const SceneConfig& scene, const std::string& partitio
   // Rank 0 partitions the mesh it read, and sends every rank its part.
   std::vector<int> cellRank;
   std::uint64_t hash = 1469598103934665603ull;  // FNV-1a over the map
-  onRankZero(rank_, [&] {
+  runOnOneRank(MPI_COMM_WORLD, 0, [&] {
     cellRank = partitionCells(scene, partitionFile);
     for (int r : cellRank) hash = (hash ^ static_cast<std::uint64_t>(r)) * 1099511628211ull;
   });

@@ -1,6 +1,11 @@
 #include "core/parallel/FailureAgreement.hpp"
 
+#include "core/Error.hpp"
+
 #include <chrono>
+#include <cstdint>
+#include <exception>
+#include <stdexcept>
 #include <thread>
 #include <vector>
 
@@ -59,6 +64,35 @@ FailureAgreement agreeOnOutcome(MPI_Comm comm, const RankOutcome& mine, double t
     a.outcome = broadcastOutcome(comm, first, mine);
   }
   return a;
+}
+
+void runOnOneRank(MPI_Comm comm, int root, const std::function<void()>& work) {
+  int rank = 0;
+  MPI_Comm_rank(comm, &rank);
+  std::uint64_t head[2] = {0, 0};  // 0 done, 1 an input error, 2 another failure; message length
+  std::string message;
+  std::exception_ptr failure;
+  if (rank == root) {
+    try {
+      work();
+    } catch (const InputError& e) {
+      head[0] = 1;
+      message = e.what();
+      failure = std::current_exception();
+    } catch (const std::exception& e) {
+      head[0] = 2;
+      message = e.what();
+      failure = std::current_exception();
+    }
+    head[1] = message.size();
+  }
+  MPI_Bcast(head, 2, MPI_UINT64_T, root, comm);
+  if (head[0] == 0) return;
+  message.resize(head[1]);
+  MPI_Bcast(message.data(), static_cast<int>(head[1]), MPI_CHAR, root, comm);
+  if (failure) std::rethrow_exception(failure);
+  if (head[0] == 1) throw InputError(message);
+  throw std::runtime_error(message);
 }
 
 }  // namespace mfsi

@@ -14,6 +14,7 @@
 /// reports on that rank and aborts the job.
 #include <mpi.h>
 
+#include <functional>
 #include <string>
 
 namespace mfsi {
@@ -36,5 +37,11 @@ struct FailureAgreement {
 /// \brief Collective over `comm` (a communicator used for nothing else). A rank that succeeded
 /// waits as long as it takes; a failed one at most `timeoutSeconds`.
 FailureAgreement agreeOnOutcome(MPI_Comm comm, const RankOutcome& mine, double timeoutSeconds);
+
+/// \brief Work that rank `root` alone does (what only it holds: the whole mesh it read, a
+/// membrane's cells). When it fails every rank fails: `root` with its own exception, the others
+/// with an error of the same kind (an InputError, or else a std::runtime_error) and message.
+/// Collective over `comm`; the others wait in a broadcast while `root` works.
+void runOnOneRank(MPI_Comm comm, int root, const std::function<void()>& work);
 
 }  // namespace mfsi

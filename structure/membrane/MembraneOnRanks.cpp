@@ -2,6 +2,7 @@
 
 #include "core/Error.hpp"
 #include "core/parallel/ByteBuffer.hpp"
+#include "core/parallel/FailureAgreement.hpp"
 
 #include <vector>
 
@@ -80,24 +81,14 @@ FluidSurfaceMembraneInput cutMembraneOnRanks(const HexMesh& part, const FluidSur
   // The owner cuts; a failure there reaches every rank as the same error.
   FluidSurfaceMembraneInput out;
   ByteWriter packed;
-  std::string failure;
-  if (rank == owner) {
-    try {
-      out = cut(part, surface);
-      pack(out, packed);
-    } catch (const std::exception& e) {
-      failure = e.what();
-    }
-  }
-  std::uint64_t sizes[2] = {packed.bytes().size(), failure.size()};
-  MPI_Bcast(sizes, 2, MPI_UINT64_T, owner, comm);
-  if (sizes[1] > 0) {
-    failure.resize(sizes[1]);
-    MPI_Bcast(failure.data(), static_cast<int>(sizes[1]), MPI_CHAR, owner, comm);
-    throw InputError(failure);
-  }
-  packed.bytes().resize(sizes[0]);
-  MPI_Bcast(packed.bytes().data(), static_cast<int>(sizes[0]), MPI_CHAR, owner, comm);
+  runOnOneRank(comm, owner, [&] {
+    out = cut(part, surface);
+    pack(out, packed);
+  });
+  std::uint64_t size = packed.bytes().size();
+  MPI_Bcast(&size, 1, MPI_UINT64_T, owner, comm);
+  packed.bytes().resize(size);
+  MPI_Bcast(packed.bytes().data(), static_cast<int>(size), MPI_CHAR, owner, comm);
   if (rank != owner) out = unpack(packed.bytes());
   return out;
 }
