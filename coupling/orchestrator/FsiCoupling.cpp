@@ -44,13 +44,12 @@ FsiCoupling::FsiCoupling(const CouplingOptions& options, const SceneConfig& sect
       options_(options),
       mesh_(mesh),
       domain_(domain != nullptr ? *domain : RankDomain{}),
-      comm_(domain != nullptr && domain->distributed() ? domain->comm : MPI_COMM_NULL),
       timers_(timers),
       fluid_(std::move(fluid)),
       ownedMembranes_(std::move(membranes)),
       rigid_(std::move(rigid)) {
   MFSI_CHECK(fluid_, "coupling: no fluid module");
-  if (comm_ != MPI_COMM_NULL) MPI_Comm_rank(comm_, &rank_);
+  if (domain_.distributed()) MPI_Comm_rank(domain_.comm, &rank_);
   fluid_->solver().keepStepStart(options_.fluidFromStepStart);
   if (ownedMembranes_.empty() && options_.bodyPatches.empty())
     throw InputError(section.where(), "the coupling needs at least one membrane cut from the fluid mesh "
@@ -71,10 +70,10 @@ FsiCoupling::FsiCoupling(const CouplingOptions& options, const SceneConfig& sect
                "coupling: " << m->name() << "'s mesh does not match its fluid surface");
     const bool baffle = po.mesh.kind == MembraneMeshKind::Baffle;
     const std::string surface = baffle ? po.mesh.baffle : po.mesh.patch;
-    p.surface = coupling::SurfaceGather(mesh_, comm_, surf, surface,
+    p.surface = coupling::SurfaceGather(mesh_, domain_.comm, surf, surface,
                                         baffle ? coupling::InterfaceSide::Baffle : coupling::InterfaceSide::Patch);
     p.iface = p.surface.gatheredInterface();
-    if (comm_ != MPI_COMM_NULL) p.owner = p.surface.ownerRank();
+    if (domain_.distributed()) p.owner = p.surface.ownerRank();
     p.dynamic = po.analysis == MembraneAnalysis::Dynamic;
     if (options_.interfaceMass > 0) {
       if (!p.dynamic)
@@ -125,9 +124,7 @@ FsiCoupling::FsiCoupling(const CouplingOptions& options, const SceneConfig& sect
   setUpBodies(section, layout);
   setUpParents(section);
   setUpChamber(section);
-  smoother_ = comm_ != MPI_COMM_NULL
-                  ? std::make_unique<coupling::MeshSmoother>(mesh_, options_.motion, *domain)
-                  : std::make_unique<coupling::MeshSmoother>(mesh_, options_.motion);
+  smoother_ = std::make_unique<coupling::MeshSmoother>(mesh_, options_.motion, domain_);
   if (!options_.bodyReach.empty()) {
     std::vector<coupling::RigidBlend::Body> reach;
     for (const auto& r : options_.bodyReach) {
@@ -149,7 +146,7 @@ FsiCoupling::FsiCoupling(const CouplingOptions& options, const SceneConfig& sect
     smoother_->setMovingNodes(moving);
   }
   if (options_.motion.columns) {
-    if (comm_ != MPI_COMM_NULL)
+    if (domain_.distributed())
       throw InputError(section.where("meshMotion.columns"), "columns run on one rank only");
     std::vector<lid_t> feet;  // one rank: a node's global id is its index
     for (const Panel& p : panels_)
@@ -252,7 +249,7 @@ void FsiCoupling::setUpChamber(const SceneConfig& section) {
     const std::vector<lid_t>& cell = p.surface.ownedCells(side);
     long long count[2] = {0, static_cast<long long>(cell.size())};  // inside, elements
     for (lid_t c : cell) count[0] += c >= 0 && regions.cellRegion[static_cast<std::size_t>(c)] == region ? 1 : 0;
-    if (comm_ != MPI_COMM_NULL) MPI_Allreduce(MPI_IN_PLACE, count, 1, MPI_LONG_LONG, MPI_SUM, comm_);
+    if (domain_.distributed()) MPI_Allreduce(MPI_IN_PLACE, count, 1, MPI_LONG_LONG, MPI_SUM, domain_.comm);
     if (count[0] != 0 && count[0] != count[1])
       throw InputError(where, "a membrane side lies partly in a closed fluid region: not supported");
     return count[0] > 0;
@@ -449,7 +446,7 @@ void FsiCoupling::addOutputFields(io::FieldFrame& frame) {
     const std::vector<gid_t>& node = p.module->fluidSurface()->fluidNode;  // global node ids
     if (points.empty()) {
       points = io::hostValues(mesh_.points(), static_cast<std::size_t>(mesh_.nNodes()));
-      if (comm_ != MPI_COMM_NULL) {
+      if (domain_.distributed()) {
         auto gid = Kokkos::create_mirror_view_and_copy(HostSpace(), mesh_.nodeGlobalIds());
         for (lid_t i = 0; i < mesh_.nOwnedNodes(); ++i) owned.emplace(gid(i), static_cast<std::size_t>(i));
       }
@@ -457,16 +454,16 @@ void FsiCoupling::addOutputFields(io::FieldFrame& frame) {
     std::vector<double> x(3 * node.size(), 0.0);
     for (std::size_t i = 0; i < node.size(); ++i) {
       std::size_t at = static_cast<std::size_t>(node[i]);
-      if (comm_ != MPI_COMM_NULL) {
+      if (domain_.distributed()) {
         const auto it = owned.find(node[i]);
         if (it == owned.end()) continue;
         at = it->second;
       }
       for (std::size_t k = 0; k < 3; ++k) x[3 * i + k] = points[3 * at + k];
     }
-    if (comm_ != MPI_COMM_NULL)
+    if (domain_.distributed())
       MPI_Reduce(rank_ == 0 ? MPI_IN_PLACE : x.data(), x.data(), static_cast<int>(x.size()), MPI_DOUBLE, MPI_SUM, 0,
-                 comm_);
+                 domain_.comm);
     if (io::OutputGrid* grid = frame.find(p.module->name()); grid && rank_ == 0) grid->points = std::move(x);
   }
 }
@@ -708,7 +705,7 @@ void FsiCoupling::shareSolve(Panel& p, double t1, double dt) {
                                   r.relativeResidual, r.seconds, s.volumeConstraint().lambda};
     std::copy(tail, tail + kReport, buffer.begin() + static_cast<std::ptrdiff_t>(n));
   }
-  MPI_Bcast(buffer.data(), static_cast<int>(buffer.size()), MPI_DOUBLE, p.owner, comm_);
+  MPI_Bcast(buffer.data(), static_cast<int>(buffer.size()), MPI_DOUBLE, p.owner, domain_.comm);
   if (mine) return;
   std::size_t at = 0;
   for (const RealView& v : views) {
@@ -1050,7 +1047,7 @@ void FsiCoupling::addMetrics(std::map<std::string, double>& m) const {
   // Which rank solves each membrane (-1: every rank), and how many rank 0 solves.
   int solvedOnRank0 = 0;
   for (const Panel& p : panels_) {
-    m["coupling." + p.module->name() + ".solved_on_rank"] = comm_ == MPI_COMM_NULL ? 0 : p.owner;
+    m["coupling." + p.module->name() + ".solved_on_rank"] = !domain_.distributed() ? 0 : p.owner;
     solvedOnRank0 += p.owner <= 0 ? 1 : 0;
   }
   m["coupling.membranes_solved_on_rank0"] = solvedOnRank0;

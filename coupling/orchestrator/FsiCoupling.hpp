@@ -203,9 +203,8 @@ class FsiCoupling final : public Module {
 
   CouplingOptions options_;
   HexMesh& mesh_;
-  RankDomain domain_;     ///< the other ranks' parts (none on one rank)
-  MPI_Comm comm_ = MPI_COMM_NULL;  ///< several ranks: the ranks
-  int rank_ = 0;                    ///< this rank in comm_ (0 on one rank)
+  RankDomain domain_;  ///< several ranks: the ranks (comm) and this rank's halo plans; one rank: none
+  int rank_ = 0;  ///< this rank in domain_.comm (0 on one rank)
   Timers& timers_;
   ExecSpace exec_;
   std::unique_ptr<FluidModule> fluid_;
