@@ -34,7 +34,8 @@ int commandPartition(const std::string& scene, const std::vector<std::string>& s
     groups = mfsi::cellGroupsKeptTogether(cfg, mesh, &kept);
     opt.keepTogether = groups;
     part = mfsi::partitionGraph(mfsi::cellDualGraph(mesh), opt);
-    for (int r = 0; r < ranks; ++r) parts.push_back(mfsi::localMeshPart(mesh, part.cellRank, ranks, r));
+    mfsi::MeshDecomposition decomposition(mesh, part.cellRank, ranks);
+    for (int r = 0; r < ranks; ++r) parts.push_back(decomposition.part(r));
   } catch (const mfsi::InputError& e) {
     std::cerr << "error: " << e.what() << "\n";
     return 2;

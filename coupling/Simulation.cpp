@@ -185,22 +185,31 @@ void Simulation::decompose(const SceneConfig& scene, const std::string& partitio
   // Rank 0 partitions the mesh it read, and sends every rank its part.
   std::vector<int> cellRank;
   std::uint64_t hash = 1469598103934665603ull;  // FNV-1a over the map
-  runOnOneRank(MPI_COMM_WORLD, 0, [&] {
-    cellRank = partitionCells(scene, partitionFile);
-    for (int r : cellRank) hash = (hash ^ static_cast<std::uint64_t>(r)) * 1099511628211ull;
-  });
-  MPI_Bcast(&hash, 1, MPI_UINT64_T, 0, MPI_COMM_WORLD);
+  {
+    ScopedTimer tp(timers_, "decompose.partition");
+    runOnOneRank(MPI_COMM_WORLD, 0, [&] {
+      cellRank = partitionCells(scene, partitionFile);
+      for (int r : cellRank) hash = (hash ^ static_cast<std::uint64_t>(r)) * 1099511628211ull;
+    });
+    MPI_Bcast(&hash, 1, MPI_UINT64_T, 0, MPI_COMM_WORLD);
+  }
   partitionHash_ = static_cast<std::int64_t>(hash >> 1);
   const HexMesh* whole = rank_ == 0 ? &mesh_ : nullptr;
-  const LocalMeshPart lp = scatterParts(MPI_COMM_WORLD, 0, whole, cellRank);
-  localMesh_ = buildHexMesh(lp.input);
+  {
+    ScopedTimer ts(timers_, "decompose.scatter");
+    const LocalMeshPart lp = scatterParts(MPI_COMM_WORLD, 0, whole, cellRank);
+    localMesh_ = buildHexMesh(lp.input);
+    domain_.comm = MPI_COMM_WORLD;
+    domain_.cells = lp.cells;
+    domain_.nodes = lp.nodes;
+    domain_.incompleteNode = lp.incompleteNode;
+  }
   localGeometry_ = allocateGeometry(localMesh_);
   computeGeometry(ExecSpace(), localMesh_, localGeometry_);
-  domain_.comm = MPI_COMM_WORLD;
-  domain_.cells = lp.cells;
-  domain_.nodes = lp.nodes;
-  domain_.incompleteNode = lp.incompleteNode;
-  partFaces_ = globalFaceIdsFromRoot(MPI_COMM_WORLD, 0, localMesh_, whole);
+  {
+    ScopedTimer tf(timers_, "decompose.faceIds");
+    partFaces_ = globalFaceIdsFromRoot(MPI_COMM_WORLD, 0, localMesh_, whole);
+  }
   mesh_ = HexMesh();  // rank 0's whole mesh is not needed past this point
   Kokkos::fence();
 }

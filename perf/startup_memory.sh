@@ -3,7 +3,8 @@
 # step, no output) on 1 and 2 ranks, 1 thread each. Prints every rank's peak resident memory and
 # rank 0's set-up timers (reading the mesh, partitioning it and handing out the parts). On several
 # ranks rank 0 alone reads the whole mesh; the others build only their part.
-#   perf/startup_memory.sh [N ...]        (default: 64 128; MFSI=<path> measures another build)
+#   perf/startup_memory.sh [N ...]        (default: 64 128; MFSI=<path> measures another build;
+#                                          RANKS="1 2 4" the rank counts, default "1 2")
 set -euo pipefail
 cd "$(dirname "$0")/.."
 sizes=("$@")
@@ -14,7 +15,7 @@ trap 'rm -rf "$work"' EXIT
 flags=(--oversubscribe --bind-to none)
 [ "$(id -u)" = 0 ] && flags+=(--allow-run-as-root)
 for n in "${sizes[@]}"; do
-  for np in 1 2; do
+  for np in ${RANKS:-1 2}; do
     dir=$work/n$n.np$np
     # Each process writes its own peak (KiB) to time.<rank> (Open MPI names the rank).
     OMP_NUM_THREADS=1 OMP_PROC_BIND=false KOKKOS_DISABLE_WARNINGS=1 \
@@ -27,7 +28,8 @@ s = json.load(open(sys.argv[1]))
 n, np = int(sys.argv[3]), int(sys.argv[4])
 peaks = [int(open(f"{sys.argv[2]}.{r}").read().split()[-1]) for r in range(np)]
 t = s["timers"]
-setup = ", ".join(f"{k} {t[k]:.2f} s" for k in ("mesh", "decompose", "setup.fluid") if k in t)
+phases = ("mesh", "decompose", "decompose.partition", "decompose.scatter", "decompose.faceIds", "setup.fluid")
+setup = ", ".join(f"{k} {t[k]:.2f} s" for k in phases if k in t)
 print(f"{n}^3 on {np} rank(s): peak memory " + ", ".join(f"rank {r} {p / 1024:.0f} MB" for r, p in enumerate(peaks)) +
       f"; rank 0 set-up: {setup}")
 PY

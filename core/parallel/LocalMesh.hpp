@@ -8,12 +8,13 @@
 /// ghosts grouped by their owner rank (ascending) and in global-id order within a group, so the
 /// values from one neighbour land in one contiguous range. Nodes likewise: a node belongs to the
 /// lowest rank whose owned cells use it. A ghost cell's face that leads out of the rank's cells
-/// goes to the patch "processor". Every rank computes every rank's ghost lists from the same
-/// global mesh and partition (no communication); that is O(global mesh) per rank, which suits the
-/// start-up of today's runs and is what a parallel mesh reader will replace.
+/// goes to the patch "processor". The parts come from the whole mesh and its partition, with no
+/// communication: MeshDecomposition makes every rank's part in one pass over the whole mesh (what
+/// the rank that reads the mesh does before it hands the parts out).
 #include "core/HexMesh.hpp"
 
 #include <cstdint>
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -45,8 +46,31 @@ struct LocalMeshPart {
   gid_t incompleteNode = -1;
 };
 
-/// \brief The part of `global` that `rank` holds under `cellRank` (one entry per global cell),
-/// with `ghostLayers` layers of face-neighbour ghost cells (>= 1).
+/// \brief Every rank's part of `global` under `cellRank` (one entry per global cell), with
+/// `ghostLayers` layers of face-neighbour ghost cells (>= 1).
+///
+/// The work over the whole mesh (its face adjacency, every rank's cell and node lists, the node
+/// owners, who sends what to whom) is done once, at construction; part(rank) then takes time in
+/// proportion to the part, so handing out N parts costs one pass over the mesh, not N. `global`
+/// must outlive the decomposition.
+class MeshDecomposition {
+ public:
+  MeshDecomposition(const HexMesh& global, const std::vector<int>& cellRank, int ranks, int ghostLayers = 1);
+  ~MeshDecomposition();
+  MeshDecomposition(const MeshDecomposition&) = delete;
+  MeshDecomposition& operator=(const MeshDecomposition&) = delete;
+
+  int ranks() const;
+  /// The part of `rank` (not const: it reuses scratch maps the size of the whole mesh).
+  LocalMeshPart part(int rank);
+
+ private:
+  struct Data;
+  std::unique_ptr<Data> d_;
+};
+
+/// \brief The part of `global` that `rank` holds: MeshDecomposition(...).part(rank), for a caller
+/// that needs one part.
 LocalMeshPart localMeshPart(const HexMesh& global, const std::vector<int>& cellRank, int ranks, int rank,
                             int ghostLayers = 1);
 

@@ -119,9 +119,10 @@ LocalMeshPart scatterParts(MPI_Comm comm, int root, const HexMesh* global, const
     return unpackPart(bytes);
   }
   MFSI_CHECK(global != nullptr, "scatterParts: the root has no mesh");
+  MeshDecomposition decomposition(*global, cellRank, ranks);
   LocalMeshPart mine;
   for (int r = 0; r < ranks; ++r) {
-    LocalMeshPart part = localMeshPart(*global, cellRank, ranks, r);
+    LocalMeshPart part = decomposition.part(r);
     if (r == root) {
       mine = std::move(part);
       continue;

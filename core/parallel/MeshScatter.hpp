@@ -5,8 +5,8 @@
 /// builds the whole mesh. What a part cannot tell by itself comes with it: the whole mesh's counts
 /// (the sizes of the global numberings) and, on request, the global face each of its faces is.
 ///
-/// The root still computes the parts one after another from the whole mesh (localMeshPart), which
-/// suits the rank counts of today's runs; a parallel reader is what removes that.
+/// The root computes the parts in one pass over the whole mesh (MeshDecomposition) and sends them
+/// one after another; a parallel reader is what would remove the whole mesh from the root.
 #include "core/HexMesh.hpp"
 #include "core/parallel/LocalMesh.hpp"
 

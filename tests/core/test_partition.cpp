@@ -4,6 +4,7 @@
 #include "core/BlockMesh.hpp"
 #include "core/Error.hpp"
 #include "core/parallel/LocalMesh.hpp"
+#include "core/parallel/MeshScatter.hpp"
 #include "core/parallel/Partition.hpp"
 #include "support/LocalParts.hpp"
 
@@ -54,8 +55,9 @@ void checkParts(const HexMeshInput& in, const std::vector<int>& cellRank, int ra
   const HexMesh global = buildHexMesh(in);
   std::vector<LocalMeshPart> parts;
   std::vector<int> ownedCount(global.nCells(), 0), ownedNodes(global.nNodes(), 0);
+  MeshDecomposition decomposition(global, cellRank, ranks);
   for (int r = 0; r < ranks; ++r) {
-    parts.push_back(localMeshPart(global, cellRank, ranks, r));
+    parts.push_back(decomposition.part(r));
     const HexMesh local = buildHexMesh(parts.back().input);  // a valid mesh of its own
     EXPECT_EQ(local.nOwnedCells(), parts.back().cells.nOwned);
     const auto cg = hostIds(local.cellGlobalIds());
@@ -141,6 +143,27 @@ TEST(LocalMesh, ABadPartitionStillGivesConsistentPlans) {
   checkParts(in, test::randomPartition(in.cells.size(), 4), 4);
 }
 
+TEST(LocalMesh, ADecompositionGivesEachPartAloneInAnyOrder) {
+  // Each part reuses the decomposition's scratch maps: a part must not see what an earlier one
+  // left there (a baffle face is kept only when the cells on both sides are the part's).
+  const HexMeshInput in = test::longBoxWithBaffle();
+  const HexMesh global = buildHexMesh(in);
+  const std::vector<int> cellRank = test::randomPartition(in.cells.size(), 4);
+  MeshDecomposition decomposition(global, cellRank, 4, 2);
+  std::vector<std::vector<char>> forward, backward(4);
+  for (int r = 0; r < 4; ++r) forward.push_back(packPart(decomposition.part(r)));
+  for (int r = 3; r >= 0; --r) backward[r] = packPart(decomposition.part(r));
+  for (int r = 0; r < 4; ++r) {
+    EXPECT_EQ(forward[r], backward[r]) << "rank " << r;
+    EXPECT_EQ(forward[r], packPart(localMeshPart(global, cellRank, 4, r, 2))) << "rank " << r;
+  }
+  std::size_t baffleFaces = 0;
+  for (int r = 0; r < 4; ++r)
+    for (const auto& b : unpackPart(forward[r]).input.baffles) baffleFaces += b.faces.size();
+  EXPECT_GT(baffleFaces, 0u) << "some baffle faces lie with both cells on one rank";
+  EXPECT_THROW(decomposition.part(4), InputError);
+}
+
 TEST(LocalMesh, OneRankIsTheWholeMeshWithoutGhosts) {
   const HexMeshInput in = test::longBoxWithBaffle();
   const HexMesh global = buildHexMesh(in);
@@ -192,3 +215,4 @@ TEST(Partition, BuiltMeshGraphEqualsTheInputGraph) {
   EXPECT_EQ(a.offsets, b.offsets);
   EXPECT_EQ(a.neighbours, b.neighbours);
 }
+
