@@ -220,6 +220,10 @@ void MeshSmoother::setMovingNodes(const std::vector<std::array<real, 3>>& points
   cg_ = LaplacianCgWork{};  // the AMG is set up again on the new weights
 }
 
+namespace {
+constexpr double kColumnMargin = M_PI / 6;  ///< how much further off than a column's next edge every other edge is
+}  // namespace
+
 lid_t MeshSmoother::setColumnFeet(const std::vector<lid_t>& feet) {
   if (!options_.columns || feet.empty()) return 0;
   if (nodeHalo_) throw InputError("coupling.meshMotion.columns runs on one rank only");
@@ -285,7 +289,9 @@ lid_t MeshSmoother::setColumnFeet(const std::vector<lid_t>& feet) {
           secondDot = std::max(secondDot, dot);
         }
       }
-      if (best < 0 || secondDot > 0.5) {
+      // The line goes on only where that edge is clearly the one: every other edge at least
+      // 30 degrees further off (a layered mesh whose layers slope by up to 60 degrees).
+      if (best < 0 || std::acos(std::min(1.0, secondDot)) < std::acos(std::min(1.0, bestDot)) + kColumnMargin) {
         ok = false;
         break;
       }

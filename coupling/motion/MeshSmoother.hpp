@@ -93,9 +93,10 @@ class MeshSmoother {
 
   /// \brief With options.columns: find the columns of nodes above the foot nodes (the membrane's nodes
   /// on a boundary patch of an extruded, layered mesh) and prescribe their interior nodes. A column
-  /// follows, from each node, the edge best aligned with the previous one (within 60 degrees) until
-  /// it meets a boundary node; a foot with more than one edge leaving the surface, a line that
-  /// turns, meets a sliding node or another column is left to the Laplacian. Returns the number of
+  /// follows, from each node, the edge best aligned with the previous one (within 60 degrees, and
+  /// every other edge at least 30 degrees further off) until it meets a boundary node; a foot with
+  /// more than one edge leaving the surface, a line that turns or has no clear next edge, or that
+  /// meets a sliding node or another column is left to the Laplacian. Returns the number of
   /// columns. Call before the first move. Throws InputError on a decomposed mesh.
   lid_t setColumnFeet(const std::vector<lid_t>& feet);
 

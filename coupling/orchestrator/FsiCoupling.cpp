@@ -151,7 +151,9 @@ FsiCoupling::FsiCoupling(const CouplingOptions& options, const SceneConfig& sect
     std::vector<lid_t> feet;  // one rank: a node's global id is its index
     for (const Panel& p : panels_)
       for (gid_t v : p.module->fluidSurface()->fluidNode) feet.push_back(static_cast<lid_t>(v));
-    if (smoother_->setColumnFeet(feet) == 0)
+    columnFeet_ = static_cast<lid_t>(feet.size());
+    columns_ = smoother_->setColumnFeet(feet);
+    if (columns_ == 0)
       throw InputError(section.where("meshMotion.columns"),
                        "no column of cell edges leaves the membranes' nodes (a membrane on a boundary patch of a "
                        "mesh extruded from it is needed)");
@@ -1051,6 +1053,10 @@ void FsiCoupling::addMetrics(std::map<std::string, double>& m) const {
     solvedOnRank0 += p.owner <= 0 ? 1 : 0;
   }
   m["coupling.membranes_solved_on_rank0"] = solvedOnRank0;
+  if (options_.motion.columns) {  // how many membrane nodes carry a column (the rim's and the edges' do not)
+    m["coupling.mesh_motion_columns"] = double(columns_);
+    m["coupling.mesh_motion_column_feet"] = double(columnFeet_);
+  }
   m["coupling.unconverged_steps"] = double(unconvergedSteps_);
   m["coupling.min_scaled_jacobian"] = minJacobian_;
   m["coupling.cut_backs"] = double(cutBacksTotal_);

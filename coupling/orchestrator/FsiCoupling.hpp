@@ -215,6 +215,7 @@ class FsiCoupling final : public Module {
   Eigen::Index bodyOffset_ = 0;  ///< the free coordinates of the rigid system in the interface vector
   std::vector<RigidPlacement> transforms_;  ///< per coupled body: its motion at the iterate being placed
   std::unique_ptr<coupling::MeshSmoother> smoother_;
+  lid_t columns_ = 0, columnFeet_ = 0;  ///< meshMotion.columns: the columns found, the membrane nodes offered
   /// meshMotion.bodies: the bodies' distance-weighted rigid motion in the mesh (the smoother's base),
   /// the coupled-body slot of each of its bodies, and the field.
   struct Reach {

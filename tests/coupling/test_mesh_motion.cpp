@@ -170,6 +170,31 @@ TEST(MeshMotion, ColumnsCarryTheWallMotionLinearlyInArcLength) {
   EXPECT_THROW(s2.move(exec), mfsi::DivergenceError);
 }
 
+TEST(MeshMotion, ColumnsRunThroughLayersThatSlope) {
+  // Vertical lines of edges through layers that slope by 40 degrees (z + tan(40) x: a housing
+  // and a membrane near their rim): each line's next edge is the vertical one, the layers' own
+  // edges 50 degrees off it. Every interior node carries a column; at 65 degrees (the layers'
+  // edges 25 degrees off) none does.
+  const int n = 6;
+  auto sloped = [&](double degrees) {
+    mfsi::HexMeshInput in = mfsi::generateBlockMesh(mfsi::boxSpec({0, 0, 0}, {1, 1, 1}, {n, n, n}));
+    for (auto& p : in.points) p[2] += std::tan(degrees * M_PI / 180) * p[0];
+    return mfsi::buildHexMesh(in);
+  };
+  for (const double degrees : {40.0, 65.0}) {
+    const auto mesh = sloped(degrees);
+    MeshSmootherOptions o;
+    o.columns = true;
+    MeshSmoother s(mesh, o);
+    auto hx = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), mesh.referencePoints());
+    std::vector<lid_t> feet;
+    for (lid_t i = 0; i < mesh.nNodes(); ++i)
+      if (std::abs(hx(i, 2) - std::tan(degrees * M_PI / 180) * hx(i, 0)) < 1e-12) feet.push_back(i);
+    ASSERT_EQ(feet.size(), static_cast<std::size_t>((n + 1) * (n + 1)));
+    EXPECT_EQ(s.setColumnFeet(feet), degrees < 60 ? (n - 1) * (n - 1) : 0) << degrees << " degrees";
+  }
+}
+
 TEST(MeshMotion, ColumnsStopWhereTheLineTurnsOrMeetsAnotherColumn) {
   // Feet on two opposite walls: the columns from the bottom run up to the top wall (a boundary
   // node), so those from the top find their lines claimed and are left to the Laplacian.
