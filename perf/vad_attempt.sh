@@ -1,10 +1,10 @@
 #!/usr/bin/env bash
-# The pulsatile VAD, work in progress (issue 17): builds the blood chamber's mesh, runs
+# The pulsatile VAD (issue 17): builds the blood chamber's mesh, runs
 # perf/scenes/vad_lumped.yaml and reports how far it gets and each cycle (perf/plot_vad.py: wall
 # time, FSI iterations, mesh quality, the membrane's centre, outlet and chamber pressures, the
 # volume balance; a figure in $VAD_PNG, by default $WORK/vad.png).
 #
-#   perf/vad_attempt.sh              # ~8 min on 1 thread (to where it stops, t = 0.395 s)
+#   perf/vad_attempt.sh              # two cycles (1.5 s), ~13 min on 1 thread
 #   perf/vad_attempt.sh --set coupling.interfaceMass=5    # extra options go to mfsi run
 #   VAD_MESH_ARGS="--around 48 --ring 9" perf/vad_attempt.sh  # options of scripts/vad_mesh.py
 set -euo pipefail
