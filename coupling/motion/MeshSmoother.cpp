@@ -251,16 +251,7 @@ lid_t MeshSmoother::setColumnFeet(const std::vector<lid_t>& feet) {
   std::vector<lid_t> hNode, hFoot;
   std::vector<real> hWeight;
   lid_t count = 0;
-  for (lid_t f : feet) {
-    // The one edge that leaves the surface.
-    lid_t next = -1;
-    int leaving = 0;
-    for (lid_t k = off(f); k < off(f + 1); ++k)
-      if (!foot[nb(k)]) {
-        next = nb(k);
-        ++leaving;
-      }
-    if (leaving != 1) continue;
+  auto trace = [&](lid_t f, lid_t next) {
     std::vector<lid_t> line{f};
     std::vector<double> s{0.0};
     bool ok = true;
@@ -299,7 +290,7 @@ lid_t MeshSmoother::setColumnFeet(const std::vector<lid_t>& feet) {
       prev = cur;
       cur = best;
     }
-    if (!ok || line.size() < 2) continue;
+    if (!ok || line.size() < 2) return;
     const double total = s.back();  // to the far boundary node `cur`
     for (std::size_t k = 1; k < line.size(); ++k) {
       claimed[line[k]] = 1;
@@ -309,6 +300,22 @@ lid_t MeshSmoother::setColumnFeet(const std::vector<lid_t>& feet) {
       fixed(line[k]) = 1;
     }
     ++count;
+  };
+  for (lid_t f : feet) {
+    // The edges that leave the surface: one on a boundary patch, one on each side of a baffle
+    // (two that point away from each other); any other foot is left to the Laplacian.
+    std::vector<lid_t> leaving;
+    for (lid_t k = off(f); k < off(f + 1); ++k)
+      if (!foot[nb(k)]) leaving.push_back(nb(k));
+    if (leaving.size() == 2) {
+      double a[3], b[3];
+      edge(f, leaving[0], a);
+      edge(f, leaving[1], b);
+      if (a[0] * b[0] + a[1] * b[1] + a[2] * b[2] > -0.5) continue;
+    } else if (leaving.size() != 1) {
+      continue;
+    }
+    for (lid_t next : leaving) trace(f, next);
   }
   columns_.node = toDevice(hNode, "mfsi::coupling::motion::columnNode");
   columns_.foot = toDevice(hFoot, "mfsi::coupling::motion::columnFoot");

@@ -92,11 +92,13 @@ class MeshSmoother {
   void setMovingNodes(const std::vector<std::array<real, 3>>& points);
 
   /// \brief With options.columns: find the columns of nodes above the foot nodes (the membrane's nodes
-  /// on a boundary patch of an extruded, layered mesh) and prescribe their interior nodes. A column
+  /// on a boundary patch of an extruded, layered mesh, or on a baffle: a column on each side) and
+  /// prescribe their interior nodes. A column
   /// follows, from each node, the edge best aligned with the previous one (within 60 degrees, and
   /// every other edge at least 30 degrees further off) until it meets a boundary node; a foot with
-  /// more than one edge leaving the surface, a line that turns or has no clear next edge, or that
-  /// meets a sliding node or another column is left to the Laplacian. Returns the number of
+  /// more edges leaving the surface than one (two on a baffle, pointing away from each other), a
+  /// line that turns or has no clear next edge, or that meets a sliding node or another column is
+  /// left to the Laplacian. Returns the number of
   /// columns. Call before the first move. Throws InputError on a decomposed mesh.
   lid_t setColumnFeet(const std::vector<lid_t>& feet);
 

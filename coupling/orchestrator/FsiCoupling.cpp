@@ -155,8 +155,8 @@ FsiCoupling::FsiCoupling(const CouplingOptions& options, const SceneConfig& sect
     columns_ = smoother_->setColumnFeet(feet);
     if (columns_ == 0)
       throw InputError(section.where("meshMotion.columns"),
-                       "no column of cell edges leaves the membranes' nodes (a membrane on a boundary patch of a "
-                       "mesh extruded from it is needed)");
+                       "no column of cell edges leaves the membranes' nodes (a membrane on a boundary patch or a "
+                       "baffle of a mesh extruded from it is needed)");
   }
   acceleration_ = coupling::makeAcceleration(options_.acceleration, layout);
 }

@@ -33,6 +33,16 @@ void bottomBump(const MeshSmoother& s, const mfsi::HexMesh& mesh, double a) {
   Kokkos::deep_copy(s.displacement(), hd);
 }
 
+/// The nodes whose reference point lies on the surface z = surface(x, y) (to 1e-12).
+template <class Surface>
+std::vector<lid_t> nodesOn(const mfsi::HexMesh& mesh, Surface surface) {
+  auto hx = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), mesh.referencePoints());
+  std::vector<lid_t> nodes;
+  for (lid_t i = 0; i < mesh.nNodes(); ++i)
+    if (std::abs(hx(i, 2) - surface(hx(i, 0), hx(i, 1))) < 1e-12) nodes.push_back(i);
+  return nodes;
+}
+
 /// Thickness of the first cell row of a box of n cells graded gz along z.
 double firstCellThickness(int n, double gz) {
   const double r = std::pow(gz, 1.0 / (n - 1));
@@ -186,13 +196,54 @@ TEST(MeshMotion, ColumnsRunThroughLayersThatSlope) {
     MeshSmootherOptions o;
     o.columns = true;
     MeshSmoother s(mesh, o);
-    auto hx = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), mesh.referencePoints());
-    std::vector<lid_t> feet;
-    for (lid_t i = 0; i < mesh.nNodes(); ++i)
-      if (std::abs(hx(i, 2) - std::tan(degrees * M_PI / 180) * hx(i, 0)) < 1e-12) feet.push_back(i);
+    const auto feet = nodesOn(mesh, [&](double x, double) { return std::tan(degrees * M_PI / 180) * x; });
     ASSERT_EQ(feet.size(), static_cast<std::size_t>((n + 1) * (n + 1)));
     EXPECT_EQ(s.setColumnFeet(feet), degrees < 60 ? (n - 1) * (n - 1) : 0) << degrees << " degrees";
   }
+}
+
+TEST(MeshMotion, ABafflesNodesCarryAColumnOnEachSide) {
+  // A baffle across the middle of a box (z = 0.5) pushed up by a bump: each interior baffle node
+  // has a column up to the lid and one down to the floor, and every node on them moves by the bump
+  // times 1 - |z - 0.5| / 0.5, exactly.
+  const int n = 6;
+  mfsi::BlockMeshSpec spec = mfsi::boxSpec({0, 0, 0}, {1, 1, 1}, {n, n, n});
+  mfsi::BaffleRect b;
+  b.name = "sheet";
+  b.axis = 2;
+  b.position = 0.5;
+  b.min = {0, 0, 0.5};
+  b.max = {1, 1, 0.5};
+  spec.baffles.push_back(b);
+  const auto mesh = mfsi::buildHexMesh(mfsi::generateBlockMesh(spec));
+  MeshSmootherOptions o;
+  o.columns = true;
+  MeshSmoother s(mesh, o);
+  EXPECT_EQ(s.setColumnFeet(nodesOn(mesh, [](double, double) { return 0.5; })), 2 * (n - 1) * (n - 1));
+  auto hx = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), mesh.referencePoints());
+  const double a = 0.2;
+  auto hd = Kokkos::create_mirror_view(s.displacement());
+  auto bump = [&](lid_t i) { return a * std::sin(M_PI * hx(i, 0)) * std::sin(M_PI * hx(i, 1)); };
+  for (lid_t i = 0; i < mesh.nNodes(); ++i) {
+    hd(i, 0) = hd(i, 1) = hd(i, 2) = 0;
+    if (std::abs(hx(i, 2) - 0.5) < 1e-12) hd(i, 2) = bump(i);
+  }
+  Kokkos::deep_copy(s.displacement(), hd);
+  mfsi::ExecSpace exec;
+  const auto rep = s.move(exec);
+  exec.fence();
+  EXPECT_GT(rep.minScaledJacobian, 0.3);
+  Kokkos::deep_copy(hd, s.displacement());
+  int checked = 0;
+  for (lid_t i = 0; i < mesh.nNodes(); ++i) {
+    const double x = hx(i, 0), y = hx(i, 1), z = hx(i, 2);
+    if (x < 1e-12 || x > 1 - 1e-12 || y < 1e-12 || y > 1 - 1e-12 || z < 1e-12 || z > 1 - 1e-12) continue;
+    if (std::abs(z - 0.5) < 1e-12) continue;
+    const double expected = bump(i) * (1 - std::abs(z - 0.5) / 0.5);
+    EXPECT_NEAR(hd(i, 2), expected, 1e-14 + 1e-12 * std::abs(expected)) << "node " << i;
+    ++checked;
+  }
+  EXPECT_EQ(checked, (n - 1) * (n - 1) * (n - 2));
 }
 
 TEST(MeshMotion, ColumnsStopWhereTheLineTurnsOrMeetsAnotherColumn) {
