@@ -23,63 +23,63 @@ void sortLocalOrder(std::vector<lid_t>& entities, const std::vector<int>& ownerO
   });
 }
 
-/// Every rank's list of one kind of entity (cells or nodes) and what each rank sends.
-struct RankLists {
-  std::vector<int> owner;                    ///< per global entity
-  std::vector<std::vector<lid_t>> local;     ///< per rank: owned, then ghosts by owner
-  std::vector<lid_t> nOwned;                 ///< per rank
-  /// Per rank: (receiving rank, local index of the owned entry sent), grouped by receiver
-  /// (ascending) and in the receiver's ghost order within a group.
-  std::vector<std::vector<std::pair<int, lid_t>>> sends;
-
-  /// Owned counts and the send lists, from `local` (already in local order) and `owner`.
-  void finish(lid_t nGlobal) {
-    const int ranks = static_cast<int>(local.size());
-    std::vector<lid_t> ownedIndex(static_cast<std::size_t>(nGlobal), -1);
-    nOwned.assign(ranks, 0);
-    for (int r = 0; r < ranks; ++r) {
-      const auto& mine = local[r];
-      while (nOwned[r] < static_cast<lid_t>(mine.size()) && owner[mine[nOwned[r]]] == r) {
-        ownedIndex[mine[nOwned[r]]] = nOwned[r];
-        ++nOwned[r];
-      }
-    }
-    sends.assign(ranks, {});
-    for (int q = 0; q < ranks; ++q)
-      for (std::size_t i = nOwned[q]; i < local[q].size(); ++i) {
-        const lid_t e = local[q][i];
-        sends[owner[e]].emplace_back(q, ownedIndex[e]);
-      }
-  }
-
-  HaloPlan plan(int rank) const {
-    const int ranks = static_cast<int>(local.size());
-    const auto& mine = local[rank];
-    HaloPlan p;
-    p.nLocal = static_cast<lid_t>(mine.size());
-    p.nOwned = nOwned[rank];
-    std::vector<lid_t> recvCount(ranks, 0), sendCount(ranks, 0);
-    for (lid_t i = p.nOwned; i < p.nLocal; ++i) ++recvCount[owner[mine[i]]];
-    for (const auto& s : sends[rank]) ++sendCount[s.first];
-    p.sendOffsets.push_back(0);
-    p.recvOffsets.push_back(0);
-    std::size_t k = 0;
-    for (int r = 0; r < ranks; ++r) {
-      if (r == rank || (sendCount[r] == 0 && recvCount[r] == 0)) continue;
-      p.neighbours.push_back(r);
-      for (; k < sends[rank].size() && sends[rank][k].first == r; ++k) p.sendIndices.push_back(sends[rank][k].second);
-      p.sendOffsets.push_back(static_cast<lid_t>(p.sendIndices.size()));
-      p.recvOffsets.push_back(p.recvOffsets.back() + recvCount[r]);
-    }
-    return p;
-  }
-};
-
 }  // namespace
 
 /// The whole mesh on the host (without a copy where its memory is the host's) and every rank's
 /// lists.
 struct MeshDecomposition::Data {
+  /// Every rank's list of one kind of entity (cells or nodes) and what each rank sends.
+  struct RankLists {
+    std::vector<int> owner;                    ///< per global entity
+    std::vector<std::vector<lid_t>> local;     ///< per rank: owned, then ghosts by owner
+    std::vector<lid_t> nOwned;                 ///< per rank
+    /// Per rank: (receiving rank, local index of the owned entry sent), grouped by receiver
+    /// (ascending) and in the receiver's ghost order within a group.
+    std::vector<std::vector<std::pair<int, lid_t>>> sends;
+
+    /// Owned counts and the send lists, from `local` (already in local order) and `owner`.
+    void finish(lid_t nGlobal) {
+      const int ranks = static_cast<int>(local.size());
+      std::vector<lid_t> ownedIndex(static_cast<std::size_t>(nGlobal), -1);
+      nOwned.assign(ranks, 0);
+      for (int r = 0; r < ranks; ++r) {
+        const auto& mine = local[r];
+        while (nOwned[r] < static_cast<lid_t>(mine.size()) && owner[mine[nOwned[r]]] == r) {
+          ownedIndex[mine[nOwned[r]]] = nOwned[r];
+          ++nOwned[r];
+        }
+      }
+      sends.assign(ranks, {});
+      for (int q = 0; q < ranks; ++q)
+        for (std::size_t i = nOwned[q]; i < local[q].size(); ++i) {
+          const lid_t e = local[q][i];
+          sends[owner[e]].emplace_back(q, ownedIndex[e]);
+        }
+    }
+
+    HaloPlan plan(int rank) const {
+      const int ranks = static_cast<int>(local.size());
+      const auto& mine = local[rank];
+      HaloPlan p;
+      p.nLocal = static_cast<lid_t>(mine.size());
+      p.nOwned = nOwned[rank];
+      std::vector<lid_t> recvCount(ranks, 0), sendCount(ranks, 0);
+      for (lid_t i = p.nOwned; i < p.nLocal; ++i) ++recvCount[owner[mine[i]]];
+      for (const auto& s : sends[rank]) ++sendCount[s.first];
+      p.sendOffsets.push_back(0);
+      p.recvOffsets.push_back(0);
+      std::size_t k = 0;
+      for (int r = 0; r < ranks; ++r) {
+        if (r == rank || (sendCount[r] == 0 && recvCount[r] == 0)) continue;
+        p.neighbours.push_back(r);
+        for (; k < sends[rank].size() && sends[rank][k].first == r; ++k) p.sendIndices.push_back(sends[rank][k].second);
+        p.sendOffsets.push_back(static_cast<lid_t>(p.sendIndices.size()));
+        p.recvOffsets.push_back(p.recvOffsets.back() + recvCount[r]);
+      }
+      return p;
+    }
+  };
+
   const HexMesh& global;
   int ranks = 1;
   lid_t nCells = 0, nNodes = 0, nInternal = 0;
