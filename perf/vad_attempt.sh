@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
 # The pulsatile VAD (issue 17): builds the blood chamber's mesh, runs
-# perf/scenes/vad_lumped.yaml and reports how far it gets and each cycle (perf/plot_vad.py: wall
+# cases/vad.yaml on it and reports how far it gets and each cycle (perf/plot_vad.py: wall
 # time, FSI iterations, mesh quality, the membrane's centre, outlet and chamber pressures, the
 # volume balance; a figure in $VAD_PNG, by default $WORK/vad.png).
 #
@@ -16,7 +16,7 @@ py=/usr/bin/python3
 mkdir -p "$work"
 # shellcheck disable=SC2086
 $py "$repo/scripts/vad_mesh.py" --blood-only ${VAD_MESH_ARGS:-} "$work/vad_blood.msh" > /dev/null
-cp "$repo/perf/scenes/vad_lumped.yaml" "$work/"
 export OMP_PROC_BIND=false
-"$mfsi" run "$work/vad_lumped.yaml" --out "$work/out" --overwrite --threads 1 "$@" > "$work/run.log" 2>&1 || true
+"$mfsi" run "$repo/cases/vad.yaml" --set mesh.file="$work/vad_blood.msh" --out "$work/out" --overwrite --threads 1 "$@" \
+  > "$work/run.log" 2>&1 || true
 $py "$repo/perf/plot_vad.py" "$work/out" --png "${VAD_PNG:-$work/vad.png}"

@@ -4,7 +4,7 @@ written as Gmsh MSH 4.1 ASCII; SI units (m).
 
     python3 scripts/vad_mesh.py                         # cases/meshes/vad.msh
     python3 scripts/vad_mesh.py --around 16 --ring 2 --blood 4 --air 2 /tmp/vad_coarse.msh
-    python3 scripts/vad_mesh.py --blood-only /tmp/vad_blood.msh   # the blood chamber alone (air lumped)
+    python3 scripts/vad_mesh.py --blood-only cases/meshes/vad_blood.msh   # the blood chamber alone (cases/vad.yaml)
     python3 scripts/vad_mesh.py --info                  # counts and quality only
 
 Geometry. Two domed chambers of width 2R = 7.7 cm separated by a membrane pinned at its rim
