@@ -258,6 +258,15 @@ Schema fluidSchema() {
            Presence::OptionalSection)
       .key("nu", Schema::real("kinematic viscosity nu = mu / rho (give this or viscosity)", "m^2/s").greaterThan(0),
            Presence::OptionalSection)
+      .key("regions",
+           Schema::list("other fluids: each in the cells its patch reaches without crossing a baffle (e.g. the air "
+                        "chamber behind a membrane with blood on its other side); the rest keep density and "
+                        "viscosity",
+                        Schema::map("a fluid region")
+                            .key("patch", Schema::string("a patch of the region (every region it touches)"))
+                            .key("density", Schema::real("density rho", "kg/m^3").greaterThan(0))
+                            .key("viscosity", Schema::real("dynamic viscosity mu", "Pa s").greaterThan(0))),
+           Presence::Optional)
       .key("bodyForce", Schema::realVector(3, "body acceleration g", "m/s^2"), Default(std::array<double, 3>{0, 0, 0}))
       .key("artificialSoundSpeed",
            Schema::real("artificial compressibility: (1/(rho c^2)) dp/dt + div u = 0; 0 = incompressible", "m/s")
@@ -363,6 +372,17 @@ FluidOptions readFluidOptions(const SceneConfig& c, const HexMesh& mesh) {
   o.viscosity = hasMu ? c.get<double>("viscosity") : c.get<double>("nu") * o.density;
   o.bodyForce = vec3(c, "bodyForce");
   o.artificialCompressibility.soundSpeed = c.get<double>("artificialSoundSpeed");
+  for (std::size_t i = 0; i < c.size("regions"); ++i) {
+    const SceneConfig r = c.child("regions." + std::to_string(i));
+    FluidRegion fr{r.get<std::string>("patch"), r.get<double>("density"), r.get<double>("viscosity")};
+    if (mesh.findPatch(fr.patch) < 0) throw InputError(r.where("patch"), mesh.noPatchMessage(fr.patch));
+    for (const FluidRegion& other : o.regions)
+      if (other.patch == fr.patch) throw InputError(r.where("patch"), "a second region for patch '" + fr.patch + "'");
+    if (o.artificialCompressibility.soundSpeed > 0)
+      throw InputError(r.where("patch"), "fluid regions with artificial compressibility (artificialSoundSpeed) are "
+                                         "not supported yet");
+    o.regions.push_back(fr);
+  }
   const std::string ts = c.get<std::string>("timeScheme");
   o.timeScheme = ts == "steady" ? TimeScheme::Steady : ts == "euler" ? TimeScheme::Euler : TimeScheme::BDF2;
   const std::string cs = c.get<std::string>("convection");

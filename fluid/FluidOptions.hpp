@@ -9,6 +9,7 @@
 #include <functional>
 #include <map>
 #include <string>
+#include <vector>
 
 namespace mfsi::fluid {
 
@@ -192,10 +193,21 @@ struct RunningMeanOptions {
   real start = 0.0;  ///< steps that end at or after this time [s] enter the means
 };
 
+/// \brief A fluid of its own in the cells a patch reaches (core/MeshRegions: cells joined through
+/// internal faces, so a baffle across the domain parts two regions): the air chamber behind a
+/// membrane whose other side holds blood. Its faces never touch another fluid's (the baffle's two
+/// sides are boundary faces), so the pressure stays the dynamic pressure [Pa] in every region.
+struct FluidRegion {
+  std::string patch;      ///< every region with a face on this patch
+  real density = 1.0;     ///< rho [kg/m^3]
+  real viscosity = 0.01;  ///< mu [Pa s]
+};
+
 /// \brief All options of `FluidSolver`.
 struct FluidOptions {
-  real density = 1.0;       ///< rho [kg/m^3]
-  real viscosity = 0.01;    ///< dynamic viscosity mu [Pa s]
+  real density = 1.0;       ///< rho [kg/m^3] (of the cells no `regions` entry names)
+  real viscosity = 0.01;    ///< dynamic viscosity mu [Pa s] (likewise)
+  std::vector<FluidRegion> regions;  ///< other fluids, each in the regions its patch reaches
   Vec3 bodyForce{0, 0, 0};  ///< body acceleration g [m/s^2]
   TimeScheme timeScheme = TimeScheme::BDF2;
   ConvectionScheme convection = ConvectionScheme::Linear;

@@ -1,6 +1,7 @@
 #include "fluid/FluidSolver.hpp"
 
 #include "core/Error.hpp"
+#include "core/MeshRegions.hpp"
 #include "fluid/MeshFlux.hpp"
 #include "kernels/DistributedAmg.hpp"
 
@@ -152,7 +153,9 @@ KOKKOS_INLINE_FUNCTION real relaxedDiagonal(real diag, real sumMagOff, real alph
 /// lambda: the compiler then inlines the call into the launch loop (a lambda this size was called
 /// per cell).
 struct MomentumRowKernel {
-  real rho = 0, mu = 0, rdt = 0, c1 = 0, c0 = 0, c00 = 0, alpha = 1;
+  real rhoUniform = 0, muUniform = 0, rdt = 0, c1 = 0, c0 = 0, c00 = 0, alpha = 1;
+  bool perCell = false;     ///< rhoC and muC per cell instead of rhoUniform and muUniform
+  ConstRealView rhoC, muC;
   real g[3] = {0, 0, 0};
   bool implicitLinear = true, steady = false, moving = true, old2 = true;
   bool dominant = false;  ///< relax from max(|a_P|, sum |a_N|) (see relaxedDiagonal)
@@ -173,6 +176,8 @@ struct MomentumRowKernel {
 
   KOKKOS_FORCEINLINE_FUNCTION void operator()(lid_t c, lid_t& firstBad) const {
     for (lid_t k = rowPtr(c); k < rowPtr(c + 1); ++k) vals(k) = 0.0;
+    // Another fluid's cells (FluidOptions::regions): every face of the row is the same fluid's.
+    const real rho = perCell ? rhoC(c) : rhoUniform, mu = perCell ? muC(c) : muUniform;
     real diag = steady ? 0.0 : rho * c1 * V(c) * rdt;
     real src[3], bsum[3] = {0.0, 0.0, 0.0}, sumOff = 0.0;
     for (int j = 0; j < 3; ++j) {
@@ -382,6 +387,8 @@ FluidSolver::FluidSolver(const HexMesh& mesh, const FluidOptions& options, const
     }
     linear_.distribute(comm_, std::move(pressure));
   }
+
+  if (!opt_.regions.empty()) setUpRegions(domain);
 
   U_ = Real3View("mfsi::fluid::U", nCells_);
   U0_ = Real3View("mfsi::fluid::U0", nCells_);
@@ -921,6 +928,36 @@ ConstTensor3View FluidSolver::velocityGradient() const {
   return gradU_;
 }
 
+void FluidSolver::setUpRegions(const RankDomain& domain) {
+  std::vector<std::string> patches;
+  for (const FluidRegion& r : opt_.regions) patches.push_back(r.patch);
+  const MeshRegions regions = findMeshRegions(mesh_, patches, domain);
+  // Each region's fluid: the entry whose patch has a face in it. Every rank asks every patch alone
+  // (the regions are the whole mesh's on every rank).
+  std::vector<int> fluidOf(static_cast<std::size_t>(regions.count), -1);
+  for (std::size_t i = 0; i < opt_.regions.size(); ++i) {
+    const MeshRegions one = findMeshRegions(mesh_, {opt_.regions[i].patch}, domain);
+    for (int r = 0; r < one.count; ++r) {
+      if (one.closed[static_cast<std::size_t>(r)]) continue;
+      int& f = fluidOf[static_cast<std::size_t>(r)];
+      MFSI_CHECK(f < 0, "fluid: patches '" << opt_.regions[static_cast<std::size_t>(f)].patch << "' and '"
+                                           << opt_.regions[i].patch << "' (fluid.regions) lie in one region");
+      f = static_cast<int>(i);
+    }
+  }
+  cellFluid_.rho = RealView("mfsi::fluid::cellDensity", nCells_);
+  cellFluid_.mu = RealView("mfsi::fluid::cellViscosity", nCells_);
+  auto rho = Kokkos::create_mirror_view(cellFluid_.rho);
+  auto mu = Kokkos::create_mirror_view(cellFluid_.mu);
+  for (lid_t c = 0; c < nCells_; ++c) {
+    const int f = fluidOf[static_cast<std::size_t>(regions.cellRegion[static_cast<std::size_t>(c)])];
+    rho(c) = f < 0 ? opt_.density : opt_.regions[static_cast<std::size_t>(f)].density;
+    mu(c) = f < 0 ? opt_.viscosity : opt_.regions[static_cast<std::size_t>(f)].viscosity;
+  }
+  Kokkos::deep_copy(cellFluid_.rho, rho);
+  Kokkos::deep_copy(cellFluid_.mu, mu);
+}
+
 // ------------------------------------------------------------------------------------------------
 // Momentum
 // ------------------------------------------------------------------------------------------------
@@ -951,12 +988,17 @@ FluidSolver::MomentumAssembly FluidSolver::assembleMomentum(bool withB, bool wit
   ConstTensor3View G = gradU_;
   auto od = fcU_.ownerDiag, nd = fcU_.neighbourDiag, up = fcU_.upper, lo = fcU_.lower;
   auto flux = fluxU_;
+  // Another fluid's cells (FluidOptions::regions): no face joins two fluids, so the owner's serves.
+  const bool perCell = cellFluid_.perCell();
+  ConstRealView rhoC = cellFluid_.rho, muC = cellFluid_.mu;
   Kokkos::parallel_for(
       "mfsi::fluid::momentum::faceCoefficients", RangePolicy(exec_, 0, nFaces_), KOKKOS_LAMBDA(lid_t f) {
-        const real F = rho * (phi(f) - mp(f));  // mass flux relative to the moving face
+        const lid_t o = own(f);
+        const real rhoF = perCell ? rhoC(o) : rho, muF = perCell ? muC(o) : mu;
+        const real F = rhoF * (phi(f) - mp(f));  // mass flux relative to the moving face
         if (f < nIn) {
-          const lid_t o = own(f), n = nei(f);
-          const real wf = w(f), D = mu * dc(f);
+          const lid_t n = nei(f);
+          const real wf = w(f), D = muF * dc(f);
           if (implicitLinear) {
             od(f) = F * wf + D;
             up(f) = F * (1.0 - wf) - D;
@@ -976,7 +1018,7 @@ FluidSolver::MomentumAssembly FluidSolver::assembleMomentum(bool withB, bool wit
             if (nonOrth) {
               real corr = 0;
               for (int i = 0; i < 3; ++i) corr += kv(f, i) * (wf * G(o, i, j) + (1.0 - wf) * G(n, i, j));
-              fl = -mu * limitedCorrection(corr, dc(f) * (U(n, j) - U(o, j)), lim);
+              fl = -muF * limitedCorrection(corr, dc(f) * (U(n, j) - U(o, j)), lim);
             }
             if (limited) {
               // Deferred correction: implicit upwind plus F (phi_TVD - phi_upwind) lagged.
@@ -996,7 +1038,7 @@ FluidSolver::MomentumAssembly FluidSolver::assembleMomentum(bool withB, bool wit
         } else {
           const lid_t b = f - nIn;
           up(f) = lo(f) = nd(f) = 0.0;
-          const real D = mu * dc(f);
+          const real D = muF * dc(f);
           switch (kind(b)) {
             case kFaceVelocity:
             case kFaceWall:
@@ -1031,11 +1073,12 @@ FluidSolver::MomentumAssembly FluidSolver::assembleMomentum(bool withB, bool wit
   auto rhs = rhsU_;
   Kokkos::parallel_for(
       "mfsi::fluid::momentum::cellTerms", RangePolicy(exec_, 0, nRows_), KOKKOS_LAMBDA(lid_t c) {
-        cd(c) = steady ? 0.0 : rho * c1 * V(c) * rdt;
+        const real rhoP = perCell ? rhoC(c) : rho;
+        cd(c) = steady ? 0.0 : rhoP * c1 * V(c) * rdt;
         const real g[3] = {gx, gy, gz};
         for (int j = 0; j < 3; ++j) {
-          real s = rho * V(c) * g[j];
-          if (!steady) s += rho * (c0 * V0(c) * U0(c, j) - c00 * V00(c) * U00(c, j)) * rdt;
+          real s = rhoP * V(c) * g[j];
+          if (!steady) s += rhoP * (c0 * V0(c) * U0(c, j) - c00 * V00(c) * U00(c, j)) * rdt;
           rhs(c, j) = s;
         }
       });
@@ -1106,8 +1149,11 @@ void FluidSolver::assembleMomentumFused(bool withB, bool withInv) {
   // of the face-coefficient path (cell term first, then the cell's faces in cellFaces() order), so
   // both give the same bits.
   MomentumRowKernel k;
-  k.rho = opt_.density;
-  k.mu = opt_.viscosity;
+  k.rhoUniform = opt_.density;
+  k.muUniform = opt_.viscosity;
+  k.perCell = cellFluid_.perCell();
+  k.rhoC = cellFluid_.rho;
+  k.muC = cellFluid_.mu;
   k.implicitLinear = opt_.convection == ConvectionScheme::Linear;
   k.steady = opt_.timeScheme == TimeScheme::Steady;
   // Skipped reads of exact zeros: the mesh flux of a mesh that has not moved for two steps, and
@@ -1253,6 +1299,8 @@ struct PhiHbyAFace {
   ConstRealView w, rAU, phi, d0, d00;
   ConstReal3View sf, H;
   real rho = 0, rdt = 0, c0 = 0, c00 = 0;
+  bool perCell = false;  ///< rhoC per cell instead of rho (FluidOptions::regions)
+  ConstRealView rhoC;
   bool ddt = false, old2 = false;
   /// Rhie-Chow consistent with the under-relaxation: (1 - a_P / relaxed a_P) interpolated, times
   /// the previous iterate's face flux minus its interpolated velocity (relaxFlux).
@@ -1270,7 +1318,7 @@ struct PhiHbyAFace {
         // Rhie-Chow consistent with the time term: the old-time part of H enters through the old
         // face fluxes rather than the interpolated old cell velocities.
         const real rAUf = wf * rAU(o) + (1.0 - wf) * rAU(n);
-        s += rAUf * rho * (old2 ? c0 * d0(f) - c00 * d00(f) : c0 * d0(f)) * rdt;
+        s += rAUf * (perCell ? rhoC(o) : rho) * (old2 ? c0 * d0(f) - c00 * d00(f) : c0 * d0(f)) * rdt;
       }
       return s;
     }
@@ -1296,6 +1344,8 @@ PhiHbyAFace FluidSolver::phiHbyAFace() const {
   F.sf = geo_.faceArea;
   F.H = HbyA_;
   F.rho = opt_.density;
+  F.perCell = cellFluid_.perCell();
+  F.rhoC = cellFluid_.rho;
   F.rdt = 1.0 / dt_;
   F.c0 = c0_;
   F.c00 = c00_;
@@ -1725,6 +1775,22 @@ real FluidSolver::prescribedInflow(int region) const {
       },
       q);
   return comm_.globalSum(q);
+}
+
+real FluidSolver::meanPressure(int region) const {
+  ConstIndexView cr = cellClosedRegion_;
+  ConstRealView V = geo_.cellVolume, pc = p_;
+  real r[2] = {0, 0};
+  Kokkos::parallel_reduce(
+      "mfsi::fluid::regionMeanPressure", RangePolicy(exec_, 0, nRows_),
+      KOKKOS_LAMBDA(lid_t c, real & pV, real & sumV) {
+        if (region >= 0 && cr(c) != region) return;
+        pV += pc(c) * V(c);
+        sumV += V(c);
+      },
+      r[0], r[1]);
+  comm_.globalSum(r, 2);
+  return r[1] > 0 ? r[0] / r[1] : 0;
 }
 
 bool FluidSolver::compressible() const {

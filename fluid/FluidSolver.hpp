@@ -150,6 +150,9 @@ class FluidSolver {
   lid_t ownedCells() const { return nRows_; }
   /// The ranks' sums and ghost exchanges (no-ops on one rank).
   const SolverComm& comm() const { return comm_; }
+  /// \brief Each cell's dynamic viscosity [Pa s] when FluidOptions::regions gives some cells another
+  /// fluid; an empty view when every cell has options().viscosity.
+  ConstRealView cellViscosity() const { return cellFluid_.mu; }
   /// The ghost cells' halo (null on one rank).
   const Halo* cellHalo() const { return cellHalo_.get(); }
   /// Number of `beginStep` calls so far.
@@ -176,6 +179,9 @@ class FluidSolver {
   /// cells, boundary faces and the level its reference cell is pinned at. Nothing else changes
   /// (the level is free there); a coupling ties it to the multiplier of a volume constraint.
   void shiftPressureLevel(int region, real delta);
+  /// \brief The volume-weighted mean pressure of closed region `region` (addClosedRegion; -1: all
+  /// cells) [Pa], over the ranks.
+  real meanPressure(int region) const;
   /// The level a closed domain (-1) or region is pinned at [Pa].
   real pressureLevel(int region) const;
   /// True when no boundary face prescribes the pressure and the fluid is incompressible: the
@@ -289,6 +295,15 @@ class FluidSolver {
   RealView regionPinValues_;            ///< per pinned row: its region's level
   std::vector<int> regionPinRegion_;    ///< per pinned row: its region
   std::vector<real> regionLevel_;       ///< per closed region: the level it is pinned at
+
+  /// Per-cell density and viscosity where FluidOptions::regions gives cells another fluid; empty
+  /// views otherwise (the kernels then read opt_.density and opt_.viscosity).
+  struct CellFluid {
+    RealView rho, mu;
+    bool perCell() const { return rho.extent(0) > 0; }
+  };
+  CellFluid cellFluid_;
+  void setUpRegions(const RankDomain& domain);
 
   MeshGeometry geo_;
   FvFaceData fd_;

@@ -12,6 +12,8 @@ void tractionRange(const FluidSolver& fluid, lid_t start, lid_t size, const Real
   const HexMesh& mesh = fluid.mesh();
   const lid_t nIn = mesh.nInternalFaces();
   const real mu = fluid.options().viscosity;
+  ConstRealView muC = fluid.cellViscosity();  // empty: every cell's is mu
+  const bool perCell = muC.extent(0) > 0;
   ConstIndexView own = mesh.faceOwner();
   ConstReal3View sf = fluid.geometry().faceArea;
   ConstRealView sm = fluid.geometry().faceAreaMag;
@@ -28,7 +30,7 @@ void tractionRange(const FluidSolver& fluid, lid_t start, lid_t size, const Real
           real tr = 0;
           for (int j = 0; j < 3; ++j) tr += G(o, k, j) * n[j];
           tp(i, k) = pb(b) * n[k];
-          tv(i, k) = -mu * (dudn + tr);
+          tv(i, k) = -(perCell ? muC(o) : mu) * (dudn + tr);
         }
       });
 }

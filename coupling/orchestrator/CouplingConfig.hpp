@@ -67,7 +67,7 @@ struct CouplingOptions {
   double maxDeltaDispFrac = 0;
   bool viscousTraction = false;  ///< add the fluid's viscous traction to the membrane loads
   /// A fluid domain with no pressure boundary (incompressible): the membrane patch that closes it
-  /// solves with a volume constraint (coupling/interface/ChamberRegions).
+  /// solves with a volume constraint (core/MeshRegions).
   bool volumeConstraint = true;
   /// \brief A gas chamber behind a membrane patch that is not meshed (its inertia negligible: the
   /// pump's air chamber): one uniform pressure, the membrane's volume constraint's multiplier, and a

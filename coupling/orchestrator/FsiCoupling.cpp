@@ -1,6 +1,6 @@
 #include "coupling/orchestrator/FsiCoupling.hpp"
 
-#include "coupling/interface/ChamberRegions.hpp"
+#include "core/MeshRegions.hpp"
 
 #include "core/io/HostCopy.hpp"
 
@@ -213,7 +213,7 @@ void FsiCoupling::setUpChamber(const SceneConfig& section) {
   for (const auto& [name, bc] : f.options().boundaries)
     if (bc.type == fluid::BoundaryType::FixedPressure || bc.type == fluid::BoundaryType::Resistance)
       pressure.push_back(name);
-  const coupling::ChamberRegions regions = coupling::findChamberRegions(mesh_, pressure, domain_);
+  const MeshRegions regions = findMeshRegions(mesh_, pressure, domain_);
   const long long nClosed = std::count(regions.closed.begin(), regions.closed.end(), char(1));
   if (nClosed == 0) return;
   // A closed region beside open ones: the fluid pins its pressure level and checks its balance.
@@ -985,9 +985,14 @@ void FsiCoupling::advance(const TimeState& t) {
       a += areas[e];
     }
     // A lumped chamber's pressure is the multiplier over the outside pressure its membrane's load
-    // is taken against.
-    last_.chamberPressure = chamber_.lumped ? options_.outsidePressure + s.volumeConstraint().lambda
-                                            : s.volumeConstraint().lambda + (a > 0 ? pa / a : 0.0);
+    // is taken against. Behind a baffle the load is the difference across it: the chamber's
+    // pressure is the multiplier plus the fluid's mean over the chamber's cells.
+    if (chamber_.lumped)
+      last_.chamberPressure = options_.outsidePressure + s.volumeConstraint().lambda;
+    else if (p.iface.side != coupling::InterfaceSide::Patch)
+      last_.chamberPressure = s.volumeConstraint().lambda + fluid_->solver().meanPressure(chamber_.fluidRegion);
+    else
+      last_.chamberPressure = s.volumeConstraint().lambda + (a > 0 ? pa / a : 0.0);
     chamber_.maxMissRun = std::max(chamber_.maxMissRun, last_.volumeMiss);
   }
   commitStructure();

@@ -25,7 +25,7 @@
 /// from the committed state (RigidBodySystem::solveStep), the step commits once.
 ///
 /// A closed chamber (an incompressible fluid with no pressure boundary, coupling/interface/
-/// ChamberRegions) closed by a membrane patch: the inflow dictates the membrane's swept volume. Each
+/// core/MeshRegions) closed by a membrane patch: the inflow dictates the membrane's swept volume. Each
 /// step the target is the volume the fluid's mesh flux needs, c1 dV = dt Q + c00 dV_last (BDF2
 /// weights), and the membrane solves with a volume constraint (MembraneVolumeConstraint: a uniform
 /// pressure as multiplier); every relaxed iterate is moved back onto the constraint before the

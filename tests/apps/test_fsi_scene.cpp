@@ -203,6 +203,14 @@ TEST(FsiScene, CouplingInputErrorsNameTheKey) {
   EXPECT_NE(e.find("fsiTolerance"), std::string::npos) << e;
   e = inputError({"coupling.minFsiIter=50"});
   EXPECT_NE(e.find("minFsiIter"), std::string::npos) << e;
+  // A fluid region on a patch that does not exist, and one with artificial compressibility.
+  e = inputError({"fluid.regions=[{patch: wals, density: 1.2, viscosity: 1.8e-5}]"});
+  EXPECT_NE(e.find("regions.0.patch"), std::string::npos) << e;
+  EXPECT_NE(e.find("did you mean 'walls'"), std::string::npos) << e;
+  e = inputError({"fluid.regions=[{patch: walls, density: 1.2, viscosity: 1.8e-5}]", "fluid.artificialSoundSpeed=10"});
+  EXPECT_NE(e.find("artificial compressibility"), std::string::npos) << e;
+  e = inputError({"fluid.regions=[{patch: walls, density: 1.2}]"});
+  EXPECT_NE(e.find("viscosity"), std::string::npos) << e;
 }
 
 TEST(FsiScene, WithoutACouplingSectionNothingIsCoupled) {

@@ -7,7 +7,7 @@
 #include "core/parallel/Halo.hpp"
 #include "core/parallel/LocalMesh.hpp"
 #include "core/parallel/Partition.hpp"
-#include "coupling/interface/ChamberRegions.hpp"
+#include "core/MeshRegions.hpp"
 #include "structure/membrane/MembraneOnRanks.hpp"
 #include "kernels/Blas.hpp"
 #include "support/LocalParts.hpp"
@@ -96,18 +96,18 @@ inline void checkGlobalSums(const HexMeshInput& in, const std::vector<int>& cell
 }
 
 
-/// The fluid regions (coupling/interface/ChamberRegions) of longBoxWithBaffle("outlet") under `cellRank`,
+/// The fluid regions (core/MeshRegions) of longBoxWithBaffle("outlet") under `cellRank`,
 /// found on each rank's part: the whole mesh's two regions (the baffle spans the box), the left one
 /// closed, numbered alike on every rank, for every cell a rank holds (owned and ghost).
 inline void checkChamberRegions(const HexMeshInput& in, const std::vector<int>& cellRank) {
   const int ranks = worldSize(), rank = worldRank();
   const HexMesh global = buildHexMesh(in);
-  const coupling::ChamberRegions one = coupling::findChamberRegions(global, {"outlet"});
+  const MeshRegions one = findMeshRegions(global, {"outlet"});
   ASSERT_EQ(one.count, 2);
   EXPECT_EQ(one.closed, (std::vector<char>{1, 0})) << "the left region (cell 0's) has no outlet";
   const LocalMeshPart part = localMeshPart(global, cellRank, ranks, rank);
   const HexMesh local = buildHexMesh(part.input);
-  const coupling::ChamberRegions many = coupling::findChamberRegions(local, {"outlet"}, worldDomain(part));
+  const MeshRegions many = findMeshRegions(local, {"outlet"}, worldDomain(part));
   EXPECT_EQ(many.count, 2) << "rank " << rank;
   EXPECT_EQ(many.closed, one.closed) << "rank " << rank;
   EXPECT_EQ(many.firstCell, one.firstCell) << "rank " << rank;

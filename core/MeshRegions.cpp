@@ -1,11 +1,11 @@
-#include "coupling/interface/ChamberRegions.hpp"
+#include "core/MeshRegions.hpp"
 
 #include "core/parallel/SharedNodes.hpp"
 
 #include <algorithm>
 #include <numeric>
 
-namespace mfsi::coupling {
+namespace mfsi {
 
 namespace {
 
@@ -45,8 +45,8 @@ bool spread(const std::vector<lid_t>& component, std::vector<double>& label) {
 
 }  // namespace
 
-ChamberRegions findChamberRegions(const HexMesh& mesh, const std::vector<std::string>& pressurePatches,
-                                  const RankDomain& domain) {
+MeshRegions findMeshRegions(const HexMesh& mesh, const std::vector<std::string>& patches,
+                            const RankDomain& domain) {
   const lid_t nCells = mesh.nCells();
   auto own = Kokkos::create_mirror_view_and_copy(HostSpace(), mesh.faceOwner());
   auto gid = Kokkos::create_mirror_view_and_copy(HostSpace(), mesh.cellGlobalIds());
@@ -67,11 +67,11 @@ ChamberRegions findChamberRegions(const HexMesh& mesh, const std::vector<std::st
       if (changed == 0) break;
     }
   }
-  // The regions, and those a pressure face opens, on every rank.
+  // The regions, and those a face of the patches opens, on every rank.
   std::vector<gid_t> labels, open;
   for (lid_t c = 0; c < nCells; ++c) labels.push_back(static_cast<gid_t>(label[c]));
   for (const Patch& p : mesh.patches()) {
-    if (std::find(pressurePatches.begin(), pressurePatches.end(), p.name) == pressurePatches.end()) continue;
+    if (std::find(patches.begin(), patches.end(), p.name) == patches.end()) continue;
     for (lid_t f = p.start; f < p.start + p.size; ++f) open.push_back(labels[own(f)]);
   }
   auto distinct = [](std::vector<gid_t> v) {
@@ -85,7 +85,7 @@ ChamberRegions findChamberRegions(const HexMesh& mesh, const std::vector<std::st
     labels = gatherRowsEverywhere(domain.comm, labels, {}, 0).ids;
     open = gatherRowsEverywhere(domain.comm, open, {}, 0).ids;
   }
-  ChamberRegions r;
+  MeshRegions r;
   r.count = static_cast<int>(labels.size());
   r.firstCell = labels;
   r.closed.assign(labels.size(), 1);
@@ -97,4 +97,4 @@ ChamberRegions findChamberRegions(const HexMesh& mesh, const std::vector<std::st
   return r;
 }
 
-}  // namespace mfsi::coupling
+}  // namespace mfsi
