@@ -10,6 +10,7 @@
 #include "core/Error.hpp"
 #include "fluid/FluidSolver.hpp"
 #include "support/Approx.hpp"
+#include "support/FluidRegionCases.hpp"
 
 #include <cmath>
 #include <map>
@@ -59,33 +60,9 @@ TEST(FluidRegions, EachColumnIsHydrostaticWithItsOwnDensity) {
 }
 
 TEST(FluidRegions, TwoChannelsOfOneKinematicViscosityFlowAlike) {
-  // Channel A (y in [0, 0.5]) and channel B (y in [0.5, 1]) parted by a baffle at y = 0.5; B is A
-  // mirrored in that plane.
-  BlockMeshSpec spec;
-  BlockSpec a, b;
-  a.min = {0, 0, 0};
-  a.max = {2, 0.5, 0.5};
-  a.cells = {10, 4, 3};
-  a.patches = {"inA", "outA", "wall", "", "wall", "wall"};
-  b = a;
-  b.min = {0, 0.5, 0};
-  b.max = {2, 1, 0.5};
-  b.patches = {"inB", "outB", "", "wall", "wall", "wall"};
-  spec.blocks = {a, b};
-  spec.baffles.push_back(BaffleRect{"panel", 1, 0.5, {0, 0.5, 0}, {2, 0.5, 0.5}});
-  HexMesh mesh = buildHexMesh(generateBlockMesh(spec));
-  FluidOptions o;
-  o.density = 1.0;
-  o.viscosity = 0.01;
-  o.regions.push_back({"inB", 4.0, 0.04});
-  o.boundaries["wall"].type = BoundaryType::Wall;
-  for (const char* in : {"inA", "inB"}) {
-    o.boundaries[in].type = BoundaryType::FlowRate;
-    o.boundaries[in].flowRate = 0.05;  // 0.2 m/s mean: Re = 10 on the channel height
-    o.boundaries[in].profile = Profile::Parabolic;
-    o.boundaries[in].parabolicAxes = {false, true, true};
-  }
-  for (const char* out : {"outA", "outB"}) o.boundaries[out].type = BoundaryType::FixedPressure;
+  // Channel B is channel A mirrored in the baffle's plane y = 0.5 (support/FluidRegionCases.hpp).
+  HexMesh mesh = buildHexMesh(test::twoChannels());
+  const FluidOptions o = test::twoChannelOptions();
   FluidSolver fluid(mesh, tight(o));
   auto C = Kokkos::create_mirror_view_and_copy(HostSpace(), fluid.geometry().cellCentroid);
   std::map<std::tuple<long, long, long>, lid_t> at;  // cell by its centroid, to 1e-6 m
