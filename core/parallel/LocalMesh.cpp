@@ -23,6 +23,25 @@ void sortLocalOrder(std::vector<lid_t>& entities, const std::vector<int>& ownerO
   });
 }
 
+/// Members grouped by a key in CSR form: group g's members are members[offsets[g] .. offsets[g + 1]),
+/// in the order `each` gives them. `each(emit)` calls emit(group, member) for every pair; it runs
+/// twice (counting, then filling).
+struct Grouping {
+  std::vector<lid_t> offsets, members;
+};
+
+template <class Each>
+Grouping groupBy(lid_t nGroups, const Each& each) {
+  Grouping g;
+  g.offsets.assign(static_cast<std::size_t>(nGroups) + 1, 0);
+  each([&g](lid_t group, lid_t) { ++g.offsets[group + 1]; });
+  for (lid_t k = 0; k < nGroups; ++k) g.offsets[k + 1] += g.offsets[k];
+  g.members.resize(g.offsets[nGroups]);
+  std::vector<lid_t> fill(g.offsets.begin(), g.offsets.end() - 1);
+  each([&](lid_t group, lid_t member) { g.members[fill[group]++] = member; });
+  return g;
+}
+
 }  // namespace
 
 /// The whole mesh on the host (without a copy where its memory is the host's) and every rank's
@@ -117,20 +136,14 @@ MeshDecomposition::MeshDecomposition(const HexMesh& global, const std::vector<in
 
   // Face adjacency of the internal faces.
   const auto neighbour = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), global.faceNeighbour());
-  std::vector<lid_t> adjOff(d.nCells + 1, 0), adj;
-  for (lid_t f = 0; f < d.nInternal; ++f) {
-    ++adjOff[d.owner(f) + 1];
-    ++adjOff[neighbour(f) + 1];
-  }
-  for (lid_t c = 0; c < d.nCells; ++c) adjOff[c + 1] += adjOff[c];
-  adj.resize(adjOff[d.nCells]);
-  {
-    std::vector<lid_t> fill(adjOff.begin(), adjOff.end() - 1);
+  const Grouping adjacency = groupBy(d.nCells, [&](auto emit) {
     for (lid_t f = 0; f < d.nInternal; ++f) {
-      adj[fill[d.owner(f)]++] = neighbour(f);
-      adj[fill[neighbour(f)]++] = d.owner(f);
+      emit(d.owner(f), neighbour(f));
+      emit(neighbour(f), d.owner(f));
     }
-  }
+  });
+  const std::vector<lid_t>& adjOff = adjacency.offsets;
+  const std::vector<lid_t>& adj = adjacency.members;
 
   // Every rank's cells: owned, then ghostLayers rings of face neighbours.
   d.cells.owner = cellRank;
@@ -179,14 +192,11 @@ MeshDecomposition::MeshDecomposition(const HexMesh& global, const std::vector<in
 
   // The boundary faces (patches and baffle sides) by owner cell.
   const lid_t nFaces = global.nFaces();
-  d.boundaryOffsets.assign(d.nCells + 1, 0);
-  for (lid_t f = d.nInternal; f < nFaces; ++f) ++d.boundaryOffsets[d.owner(f) + 1];
-  for (lid_t c = 0; c < d.nCells; ++c) d.boundaryOffsets[c + 1] += d.boundaryOffsets[c];
-  d.boundaryFaces.resize(d.boundaryOffsets[d.nCells]);
-  {
-    std::vector<lid_t> fill(d.boundaryOffsets.begin(), d.boundaryOffsets.end() - 1);
-    for (lid_t f = d.nInternal; f < nFaces; ++f) d.boundaryFaces[fill[d.owner(f)]++] = f;
-  }
+  Grouping boundary = groupBy(d.nCells, [&](auto emit) {
+    for (lid_t f = d.nInternal; f < nFaces; ++f) emit(d.owner(f), f);
+  });
+  d.boundaryOffsets = std::move(boundary.offsets);
+  d.boundaryFaces = std::move(boundary.members);
   d.cellLocal.assign(d.nCells, -1);
   d.nodeLocal.assign(d.nNodes, -1);
 }
@@ -330,20 +340,14 @@ std::vector<std::int64_t> globalFaceIdsOfKeys(const HexMesh& global, const std::
   for (lid_t c = 0; c < nCells; ++c) maxCellId = std::max(maxCellId, gcid(c));
   std::vector<lid_t> cellOfId(static_cast<std::size_t>(maxCellId + 1), -1);
   for (lid_t c = 0; c < nCells; ++c) cellOfId[gcid(c)] = c;
-  std::vector<lid_t> offsets(static_cast<std::size_t>(nCells) + 1, 0), cellFaces;
-  for (lid_t f = 0; f < nFaces; ++f) {
-    ++offsets[gown(f) + 1];
-    if (f < nInternal) ++offsets[gnei(f) + 1];
-  }
-  for (lid_t c = 0; c < nCells; ++c) offsets[c + 1] += offsets[c];
-  cellFaces.resize(offsets[nCells]);
-  {
-    std::vector<lid_t> fill(offsets.begin(), offsets.end() - 1);
+  const Grouping byCell = groupBy(nCells, [&](auto emit) {
     for (lid_t f = 0; f < nFaces; ++f) {
-      cellFaces[fill[gown(f)]++] = f;
-      if (f < nInternal) cellFaces[fill[gnei(f)]++] = f;
+      emit(gown(f), f);
+      if (f < nInternal) emit(gnei(f), f);
     }
-  }
+  });
+  const std::vector<lid_t>& offsets = byCell.offsets;
+  const std::vector<lid_t>& cellFaces = byCell.members;
   const std::size_t n = keys.size() / 5;
   std::vector<std::int64_t> ids(n);
   for (std::size_t f = 0; f < n; ++f) {
