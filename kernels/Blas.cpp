@@ -50,28 +50,8 @@ void spmv(const ExecSpace& exec, const CsrMatrix& A, const ConstRealView& x, con
 }
 
 void spmv(const ExecSpace& exec, real alpha, const CsrMatrix& A, const ConstRealView& x, real beta, const RealView& y) {
-  if (detail::useRuns(A)) {
-    const detail::RunView R(A);
-    const double* xp = x.data();
-    double* yp = y.data();
-    exec.fence();
-    Kokkos::parallel_for("mfsi::kernels::blas::spmv", detail::hostPolicy(exec, 0, A.runs.count), [=](lid_t r) {
-      detail::forRunRows(R, r, [&](lid_t i, const double* v, const lid_t* off, auto width) {
-        const double s = detail::runRowDot(v, xp, i, off, width);
-        yp[i] = beta == 0.0 ? alpha * s : alpha * s + beta * yp[i];
-      });
-    });
-    HostExecSpace().fence();
-    return;
-  }
-  const ConstIndexView rowPtr = A.rowPtr, colIdx = A.colIdx;
-  const ConstRealView val = A.values;
-  Kokkos::parallel_for(
-      "mfsi::kernels::blas::spmv", RangePolicy(exec, 0, A.nRows), KOKKOS_LAMBDA(lid_t i) {
-        double s = 0.0;
-        for (lid_t k = rowPtr(i); k < rowPtr(i + 1); ++k) s += val(k) * x(colIdx(k));
-        y(i) = beta == 0.0 ? alpha * s : alpha * s + beta * y(i);
-      });
+  detail::spmvRows(exec, "mfsi::kernels::blas::spmv", alpha, A.nRows, A.runs, A.rowPtr, A.colIdx, ConstRealView(A.values),
+                   x, beta, y);
 }
 
 double spmvDot(const ExecSpace& exec, const SolverComm& comm, const CsrMatrix& A, const ConstRealView& x,

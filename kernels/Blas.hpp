@@ -281,6 +281,36 @@ std::array<double, N> reduceRuns(const ExecSpace& exec, const SolverComm& comm, 
 /// Whether A's kernels take the run path.
 inline bool useRuns(const CsrMatrix& A) { return kHostExec && A.runs.count > 0; }
 
+/// y = alpha M x + beta y (beta = 0: y not read) for a CSR matrix whose values `val` are of type S
+/// (rowPtr, colIdx and runs a CsrMatrix's; a float copy of its values shares them): row by row,
+/// and on host backends by M's row runs. blas::spmv (S = double) and the distributed AMG's cycle
+/// (kernels/DistributedAmg.cpp, S = float or double).
+template <class S, class Val, class X, class Y>
+void spmvRows(const ExecSpace& exec, const char* label, S alpha, lid_t nRows, const CsrRowRuns& runs,
+              const IndexView& rowPtr, const IndexView& colIdx, const Val& val, const X& x, S beta, const Y& y) {
+  if (kHostExec && runs.count > 0) {
+    const RunViewOf<S> R(runs, rowPtr, val.data());
+    const S* xp = x.data();
+    S* yp = y.data();
+    exec.fence();
+    Kokkos::parallel_for(label, hostPolicy(exec, 0, runs.count), [=](lid_t r) {
+      forRunRows(R, r, [&](lid_t i, const S* v, const lid_t* off, auto width) {
+        const S t = runRowDot(v, xp, i, off, width);
+        yp[i] = beta == 0 ? alpha * t : alpha * t + beta * yp[i];
+      });
+    });
+    HostExecSpace().fence();
+    return;
+  }
+  const ConstIndexView rp = rowPtr, ci = colIdx;
+  Kokkos::parallel_for(
+      label, RangePolicy(exec, 0, nRows), KOKKOS_LAMBDA(lid_t i) {
+        S t = 0;
+        for (lid_t k = rp(i); k < rp(i + 1); ++k) t += val(k) * x(ci(k));
+        y(i) = beta == 0 ? alpha * t : alpha * t + beta * y(i);
+      });
+}
+
 }  // namespace detail
 
 /// \brief y = A x (rows [0, A.nRows); x has A.nCols entries).

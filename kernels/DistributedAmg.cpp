@@ -256,31 +256,11 @@ CycleMat<S> cycleMat(const ExecSpace& exec, const CsrMatrix& M) {
   return C;
 }
 
-/// y = alpha M x + beta y (beta = 0: y not read), row by row; host backends sweep M's row runs.
+/// y = alpha M x + beta y (beta = 0: y not read): blas::spmv's kernels in S.
 template <class S>
 void spmv(const ExecSpace& exec, S alpha, const CycleMat<S>& M, const SView<S>& x, S beta, const SView<S>& y) {
-  if (kHostExec && M.runs.count > 0) {
-    const blas::detail::RunViewOf<S> R(M.runs, M.rowPtr, M.val.data());
-    const S* xp = x.data();
-    S* yp = y.data();
-    exec.fence();
-    Kokkos::parallel_for("mfsi::kernels::damg::spmv", blas::detail::hostPolicy(exec, 0, M.runs.count), [=](lid_t r) {
-      blas::detail::forRunRows(R, r, [&](lid_t i, const S* v, const lid_t* off, auto width) {
-        const S t = blas::detail::runRowDot(v, xp, i, off, width);
-        yp[i] = beta == 0 ? alpha * t : alpha * t + beta * yp[i];
-      });
-    });
-    HostExecSpace().fence();
-    return;
-  }
-  const IndexView rowPtr = M.rowPtr, colIdx = M.colIdx;
-  const SView<S> val = M.val;
-  Kokkos::parallel_for(
-      "mfsi::kernels::damg::spmv", RangePolicy(exec, 0, M.nRows), KOKKOS_LAMBDA(lid_t i) {
-        S t = 0;
-        for (lid_t k = rowPtr(i); k < rowPtr(i + 1); ++k) t += val(k) * x(colIdx(k));
-        y(i) = beta == 0 ? alpha * t : alpha * t + beta * y(i);
-      });
+  blas::detail::spmvRows(exec, "mfsi::kernels::damg::spmv", alpha, M.nRows, M.runs, M.rowPtr, M.colIdx, M.val, x,
+                         beta, y);
 }
 
 /// d = c * inv .* r on the first n entries.
