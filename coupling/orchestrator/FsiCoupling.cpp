@@ -186,22 +186,34 @@ void FsiCoupling::setUpLumpedChamber(const SceneConfig& section) {
   if (!p.dynamic)
     throw InputError(where, lc.membrane + ": a lumped chamber's volume constraint needs the dynamic analysis");
   if (p.mounted) throw InputError(where, lc.membrane + ": a lumped chamber behind a mounted membrane is not supported yet");
-  if (chamber_.panel >= 0)
-    throw InputError(where, "the fluid also has a closed region; a second volume constraint is not supported yet");
-  chamber_.lumped = true;
   // The chamber lies on the side the element normals (out of the fluid) point into.
-  activateChamber(i, -1);
+  addChamber(i, -1, -1, true);
 }
 
-void FsiCoupling::activateChamber(int panel, real sign) {
-  chamber_.panel = panel;
+void FsiCoupling::addChamber(int panel, real sign, int fluidRegion, bool lumped) {
+  Chamber c;
+  c.panel = panel;
+  c.fluidRegion = fluidRegion;
+  c.lumped = lumped;
   MembraneSolver& s = panels_[panel].module->solver();
   MembraneVolumeConstraint& vc = s.volumeConstraint();
   vc.active = true;
   vc.sign = sign;
   vc.lambda = 0;
-  chamber_.volumeStart = s.enclosedVolume(s.displacement());
-  vc.target = chamber_.volumeStart;
+  c.volumeStart = s.enclosedVolume(s.displacement());
+  vc.target = c.volumeStart;
+  chambers_.push_back(c);
+}
+
+int FsiCoupling::chamberOf(int panel) const {
+  for (std::size_t k = 0; k < chambers_.size(); ++k)
+    if (chambers_[k].panel == panel) return static_cast<int>(k);
+  return -1;
+}
+
+std::string FsiCoupling::chamberName(std::size_t chamber, const std::string& name) const {
+  if (chambers_.size() == 1) return name;
+  return name + "." + membraneNames()[static_cast<std::size_t>(chambers_[chamber].panel)];
 }
 
 void FsiCoupling::setUpChamber(const SceneConfig& section) {
@@ -216,7 +228,7 @@ void FsiCoupling::setUpChamber(const SceneConfig& section) {
   const MeshRegions regions = findMeshRegions(mesh_, pressure, domain_);
   const long long nClosed = std::count(regions.closed.begin(), regions.closed.end(), char(1));
   if (nClosed == 0) return;
-  // A closed region beside open ones: the fluid pins its pressure level and checks its balance.
+  // Closed regions beside open ones: the fluid pins each one's pressure level and checks its balance.
   auto registerRegion = [&](int r) {
     std::vector<char> local(static_cast<std::size_t>(mesh_.nCells()));
     for (lid_t c = 0; c < mesh_.nCells(); ++c) local[c] = regions.cellRegion[static_cast<std::size_t>(c)] == r;
@@ -231,23 +243,16 @@ void FsiCoupling::setUpChamber(const SceneConfig& section) {
     return;
   }
   const auto where = section.where("volumeConstraint");
-  if (chamber_.lumped)
-    throw InputError(where, "the fluid has a region no pressure boundary reaches besides the lumped chamber behind " +
-                                options_.lumpedChamber.membrane +
-                                ": a second volume constraint is not supported yet; give that region a pressure "
-                                "boundary");
-  if (nClosed > 1)
+  if (f.closedDomain() && nClosed > 1)
     throw InputError(where, "the fluid mesh has " + std::to_string(nClosed) +
-                                " regions no pressure boundary reaches: one volume constraint per region is not "
-                                "supported yet; set coupling.volumeConstraint: false or use artificial "
-                                "compressibility (fluid.artificialSoundSpeed)");
-  const int region = static_cast<int>(std::find(regions.closed.begin(), regions.closed.end(), char(1)) -
-                                      regions.closed.begin());
-  // The membrane sides that bound the region: a patch's fluid side, a baffle's master side (the
+                                " regions and no pressure boundary: give one of them a pressure boundary, set "
+                                "coupling.volumeConstraint: false or use artificial compressibility "
+                                "(fluid.artificialSoundSpeed)");
+  // The membrane sides that bound a region: a patch's fluid side, a baffle's master side (the
   // region grows along the membrane normal) or slave side (it shrinks). A baffle with fluid of the
   // region on both sides sweeps no net volume of it.
   // Each element's cell is owned by one rank, which counts it.
-  auto sideIn = [&](const Panel& p, int side) {
+  auto sideIn = [&](const Panel& p, int side, int region) {
     const std::vector<lid_t>& cell = p.surface.ownedCells(side);
     long long count[2] = {0, static_cast<long long>(cell.size())};  // inside, elements
     for (lid_t c : cell) count[0] += c >= 0 && regions.cellRegion[static_cast<std::size_t>(c)] == region ? 1 : 0;
@@ -256,65 +261,77 @@ void FsiCoupling::setUpChamber(const SceneConfig& section) {
       throw InputError(where, "a membrane side lies partly in a closed fluid region: not supported");
     return count[0] > 0;
   };
-  double sign = 0;
-  for (std::size_t i = 0; i < panels_.size(); ++i) {
-    const Panel& p = panels_[i];
-    const bool front = sideIn(p, 0), back = p.surface.sides() == 2 && sideIn(p, 1);
-    if (front == back) continue;
-    if (chamber_.panel >= 0)
-      throw InputError(where, "a closed fluid region is bounded by two membranes (" +
-                                  panels_[chamber_.panel].module->name() + " and " + p.module->name() +
-                                  "): one volume constraint shared by several membranes is not supported yet");
-    if (!p.dynamic)
-      throw InputError(where, p.module->name() + " closes a fluid region: its volume constraint needs the dynamic "
-                              "analysis (membranes.N.analysis: dynamic)");
-    if (p.mounted)
-      throw InputError(where, p.module->name() + " closes a fluid region on moving bodies: a volume constraint "
-                              "for a mounted membrane is not supported yet");
-    chamber_.panel = static_cast<int>(i);
-    sign = front ? 1.0 : -1.0;
+  for (int region = 0; region < regions.count; ++region) {
+    if (!regions.closed[static_cast<std::size_t>(region)]) continue;
+    int panel = -1;
+    double sign = 0;
+    for (std::size_t i = 0; i < panels_.size(); ++i) {
+      const Panel& p = panels_[i];
+      const bool front = sideIn(p, 0, region), back = p.surface.sides() == 2 && sideIn(p, 1, region);
+      if (front == back) continue;
+      if (panel >= 0)
+        throw InputError(where, "a closed fluid region is bounded by two membranes (" +
+                                    panels_[panel].module->name() + " and " + p.module->name() +
+                                    "): one volume constraint shared by several membranes is not supported yet");
+      if (!p.dynamic)
+        throw InputError(where, p.module->name() + " closes a fluid region: its volume constraint needs the "
+                                "dynamic analysis (membranes.N.analysis: dynamic)");
+      if (p.mounted)
+        throw InputError(where, p.module->name() + " closes a fluid region on moving bodies: a volume constraint "
+                                "for a mounted membrane is not supported yet");
+      if (chamberOf(static_cast<int>(i)) >= 0)
+        throw InputError(where, p.module->name() + " closes two chambers (" +
+                                    (chambers_[chamberOf(static_cast<int>(i))].lumped ? "a lumped one and "
+                                                                                       : "fluid regions on both sides, ") +
+                                    "a fluid region): one volume constraint per membrane; give one of them a "
+                                    "pressure boundary");
+      panel = static_cast<int>(i);
+      sign = front ? 1.0 : -1.0;
+    }
+    if (panel < 0) {
+      if (f.closedDomain()) return;  // no membrane closes it: the fluid checks that its fluxes balance
+      throw InputError(where, "a region of the fluid no pressure boundary reaches is closed by no membrane: its "
+                              "pressure level is undefined; give it a pressure boundary or artificial "
+                              "compressibility");
+    }
+    // The membrane's element normals are the fluid faces' area vectors (the master side's on a
+    // baffle; coupling/interface/MembraneInterface).
+    addChamber(panel, sign, f.closedDomain() ? -1 : registerRegion(region), false);
   }
-  if (chamber_.panel < 0) {
-    if (f.closedDomain()) return;  // no membrane closes it: the fluid checks that its fluxes balance
-    throw InputError(where, "a region of the fluid no pressure boundary reaches is closed by no membrane: its pressure "
-                            "level is undefined; give it a pressure boundary or artificial compressibility");
-  }
-  if (!f.closedDomain()) chamber_.fluidRegion = registerRegion(region);
-  // The membrane's element normals are the fluid faces' area vectors (the master side's on a
-  // baffle; coupling/interface/MembraneInterface).
-  activateChamber(chamber_.panel, sign);
 }
 
 void FsiCoupling::beginChamberStep() {
-  if (chamber_.panel < 0) return;
-  if (chamber_.lumped) {
-    // The inflow's integral over the step (composite Simpson on 64 intervals: the pump's pulses
-    // have square-root ends).
-    const CouplingOptions::LumpedChamber& lc = options_.lumpedChamber;
-    const fluid::FluidSolver& f = fluid_->solver();
-    const double t0 = f.time(), h = f.timeStep() / 64;
-    double sum = 0;
-    for (int k = 0; k <= 64; ++k) sum += (k == 0 || k == 64 ? 1 : k % 2 ? 4 : 2) * lc.timeFunction(t0 + k * h);
-    last_.volumeStep = lc.flowRate * sum * h / 3;
-    panels_[chamber_.panel].module->solver().volumeConstraint().target = chamber_.volumeStart + last_.volumeStep;
-    return;
+  for (Chamber& c : chambers_) {
+    c.volumeMiss = 0;
+    if (c.lumped) {
+      // The inflow's integral over the step (composite Simpson on 64 intervals: the pump's pulses
+      // have square-root ends).
+      const CouplingOptions::LumpedChamber& lc = options_.lumpedChamber;
+      const fluid::FluidSolver& f = fluid_->solver();
+      const double t0 = f.time(), h = f.timeStep() / 64;
+      double sum = 0;
+      for (int k = 0; k <= 64; ++k) sum += (k == 0 || k == 64 ? 1 : k % 2 ? 4 : 2) * lc.timeFunction(t0 + k * h);
+      c.volumeStep = lc.flowRate * sum * h / 3;
+    } else {
+      // Every boundary face's flux sums to zero: the membrane's mesh flux (c1 dV^{n+1} - c00 dV^n) / dt
+      // equals the prescribed inflow Q at t_n+1.
+      const fluid::FluidSolver& f = fluid_->solver();
+      const fluid::FluidSolver::MeshFluxWeights w = f.meshFluxWeights();
+      const double q = f.prescribedInflow(c.fluidRegion);
+      c.volumeStep = (w.dt * q + w.c00 * c.sweptLast) / w.c1;
+    }
+    panels_[c.panel].module->solver().volumeConstraint().target = c.volumeStart + c.volumeStep;
   }
-  // Every boundary face's flux sums to zero: the membrane's mesh flux (c1 dV^{n+1} - c00 dV^n) / dt
-  // equals the prescribed inflow Q at t_n+1.
-  const fluid::FluidSolver& f = fluid_->solver();
-  const fluid::FluidSolver::MeshFluxWeights w = f.meshFluxWeights();
-  const double q = f.prescribedInflow(chamber_.fluidRegion);
-  last_.volumeStep = (w.dt * q + w.c00 * chamber_.sweptLast) / w.c1;
-  panels_[chamber_.panel].module->solver().volumeConstraint().target = chamber_.volumeStart + last_.volumeStep;
 }
 
 void FsiCoupling::checkChamberVolume(const InterfaceVector& x) {
-  if (chamber_.panel < 0) return;
-  Panel& p = panels_[chamber_.panel];
-  MembraneSolver& s = p.module->solver();
-  copySegmentToDevice(x, p.offset, p.iterate);
-  const double miss = std::abs(s.enclosedVolume(p.iterate) - s.volumeConstraint().target);
-  last_.volumeMiss = std::max(last_.volumeMiss, miss);
+  for (Chamber& c : chambers_) {
+    Panel& p = panels_[c.panel];
+    MembraneSolver& s = p.module->solver();
+    copySegmentToDevice(x, p.offset, p.iterate);
+    c.volumeMiss = std::max(c.volumeMiss, std::abs(s.enclosedVolume(p.iterate) - s.volumeConstraint().target));
+    last_.volumeMiss = std::max(last_.volumeMiss, c.volumeMiss);
+  }
 }
 
 void FsiCoupling::setUpBodies(const SceneConfig& section, std::vector<coupling::InterfaceBlock>& layout) {
@@ -742,13 +759,15 @@ void FsiCoupling::setTrial(InterfaceVector& x) {
     MembraneSolver& s = p.module->solver();
     if (p.dynamic) {
       copySegmentToDevice(x, p.offset, p.iterate);
-      if (static_cast<int>(i) == chamber_.panel) {
+      const int k = chamberOf(static_cast<int>(i));
+      if (k >= 0) {
         // A relaxed iterate misses the volume to second order in its update: the fluid must get one
         // it can follow.
         s.projectOntoVolume(p.iterate);
         copySegmentToHost(p.iterate, x, p.offset);
-        last_.volumeMiss =
-            std::max(last_.volumeMiss, std::abs(s.enclosedVolume(p.iterate) - s.volumeConstraint().target));
+        Chamber& c = chambers_[static_cast<std::size_t>(k)];
+        c.volumeMiss = std::max(c.volumeMiss, std::abs(s.enclosedVolume(p.iterate) - s.volumeConstraint().target));
+        last_.volumeMiss = std::max(last_.volumeMiss, c.volumeMiss);
       }
       s.setTrialDisplacement(p.iterate);
     } else {
@@ -894,7 +913,7 @@ void FsiCoupling::advance(const TimeState& t) {
     // The structure is frozen and the mesh fixed until fsiStartTime.
     solveFluid(t);
     for (Panel& p : panels_) p.module->solver().setTime(t1);
-    chamber_.sweptLast = 0;
+    for (Chamber& c : chambers_) c.sweptLast = 0;
     fluid_->endStep();
     last_.converged = true;
     ++steps_;
@@ -965,44 +984,45 @@ void FsiCoupling::advance(const TimeState& t) {
   // Converged (or explicit): the structure's last answer is committed; the fluid saw the mesh at x,
   // within fsiTol of it. Not converged: the last relaxed iterate, which the mesh and fluid match.
   if (!last_.converged && implicit) setTrial(x);
-  if (chamber_.panel >= 0) {
+  for (Chamber& c : chambers_) {
     // The fluid mesh ends the step at `good` (the last iterate moved to): the next step's start.
-    Panel& p = panels_[chamber_.panel];
+    Panel& p = panels_[c.panel];
     MembraneSolver& s = p.module->solver();
     copySegmentToDevice(good, p.offset, p.iterate);
     const double v = s.enclosedVolume(p.iterate);
-    chamber_.sweptLast = v - chamber_.volumeStart;
-    chamber_.volumeStart = v;
-    // The fluid's pressure level in a closed domain is that of its reference cell and drifts with
-    // the pressure solver's tolerance; the multiplier takes up the difference, so the pressure on
-    // the membrane is the multiplier plus the fluid's mean load on it.
-    const RealView load = p.load;
-    const std::vector<real>& areas = s.mesh().elementAreas();
-    auto h = Kokkos::create_mirror_view_and_copy(HostSpace(), load);
-    double pa = 0, a = 0;
-    for (std::size_t e = 0; e < areas.size(); ++e) {
-      pa += areas[e] * h(e);
-      a += areas[e];
-    }
+    c.sweptLast = v - c.volumeStart;
+    c.volumeStart = v;
     // A lumped chamber's pressure is the multiplier over the outside pressure its membrane's load
     // is taken against. Behind a baffle the load is the difference across it: the chamber's
-    // pressure is the multiplier plus the fluid's mean over the chamber's cells.
-    if (chamber_.lumped)
-      last_.chamberPressure = options_.outsidePressure + s.volumeConstraint().lambda;
-    else if (p.iface.side != coupling::InterfaceSide::Patch)
-      last_.chamberPressure = s.volumeConstraint().lambda + fluid_->solver().meanPressure(chamber_.fluidRegion);
-    else
-      last_.chamberPressure = s.volumeConstraint().lambda + (a > 0 ? pa / a : 0.0);
-    chamber_.maxMissRun = std::max(chamber_.maxMissRun, last_.volumeMiss);
+    // pressure is the multiplier plus the fluid's mean over the chamber's cells. Behind a patch:
+    // the multiplier plus the fluid's mean load on the membrane (the fluid's pressure level in a
+    // closed domain is that of its reference cell and drifts with the pressure solver's tolerance;
+    // the multiplier takes up the difference).
+    if (c.lumped) {
+      c.pressure = options_.outsidePressure + s.volumeConstraint().lambda;
+    } else if (p.iface.side != coupling::InterfaceSide::Patch) {
+      c.pressure = s.volumeConstraint().lambda + fluid_->solver().meanPressure(c.fluidRegion);
+    } else {
+      const std::vector<real>& areas = s.mesh().elementAreas();
+      auto h = Kokkos::create_mirror_view_and_copy(HostSpace(), p.load);
+      double pa = 0, a = 0;
+      for (std::size_t e = 0; e < areas.size(); ++e) {
+        pa += areas[e] * h(e);
+        a += areas[e];
+      }
+      c.pressure = s.volumeConstraint().lambda + (a > 0 ? pa / a : 0.0);
+    }
+    c.maxMissRun = std::max(c.maxMissRun, c.volumeMiss);
   }
   commitStructure();
-  if (chamber_.panel >= 0 && !chamber_.lumped) {
+  for (const Chamber& c : chambers_) {
+    if (c.lumped) continue;
     // The fluid's pressure level in the chamber takes over the multiplier: its field is then the
     // physical pressure, and the next step's multiplier is the change of the level over it.
-    Panel& p = panels_[chamber_.panel];
+    Panel& p = panels_[c.panel];
     MembraneSolver& s = p.module->solver();
     const real lambda = s.volumeConstraint().lambda, shift = s.volumeConstraint().sign * lambda;
-    fluid_->solver().shiftPressureLevel(chamber_.fluidRegion, lambda);
+    fluid_->solver().shiftPressureLevel(c.fluidRegion, lambda);
     s.shiftMultiplier(-lambda);
     for (const RealView& v : {p.load, p.loadPrevious, p.filtered})
       if (v.extent(0) > 0) blas::shift(exec_, static_cast<lid_t>(v.extent(0)), shift, v);
@@ -1036,7 +1056,9 @@ void FsiCoupling::advance(const TimeState& t) {
 std::vector<std::string> FsiCoupling::stepColumns() const {
   std::vector<std::string> c{"iterations",        "displacementResidual", "forceResidual",    "omega",  "columns",
                              "minScaledJacobian", "cutBacks",             "motionIterations", "limited"};
-  if (chamber_.panel >= 0) c.insert(c.end(), {"chamberVolumeStep", "chamberVolumeMiss", "chamberPressure"});
+  for (std::size_t k = 0; k < chambers_.size(); ++k)
+    for (const char* name : {"chamberVolumeStep", "chamberVolumeMiss", "chamberPressure"})
+      c.push_back(chamberName(k, name));
   return c;
 }
 
@@ -1044,7 +1066,7 @@ void FsiCoupling::appendStepValues(std::vector<double>& v) const {
   v.insert(v.end(), {double(last_.iterations), last_.displacementResidual, last_.forceResidual, last_.omega,
                      double(last_.columns), last_.minScaledJacobian, double(last_.cutBacks),
                      double(last_.motionIterations), double(last_.limited)});
-  if (chamber_.panel >= 0) v.insert(v.end(), {last_.volumeStep, last_.volumeMiss, last_.chamberPressure});
+  for (const Chamber& c : chambers_) v.insert(v.end(), {c.volumeStep, c.volumeMiss, c.pressure});
 }
 
 void FsiCoupling::addMetrics(std::map<std::string, double>& m) const {
@@ -1066,10 +1088,11 @@ void FsiCoupling::addMetrics(std::map<std::string, double>& m) const {
   m["coupling.min_scaled_jacobian"] = minJacobian_;
   m["coupling.cut_backs"] = double(cutBacksTotal_);
   m["coupling.limited_updates"] = double(limitedTotal_);
-  if (chamber_.panel >= 0) {
-    m["coupling.chamber_max_volume_miss"] = chamber_.maxMissRun;
-    m["coupling.chamber_volume"] = chamber_.volumeStart;
-    m["coupling.chamber_pressure"] = last_.chamberPressure;
+  for (std::size_t k = 0; k < chambers_.size(); ++k) {
+    const Chamber& c = chambers_[k];
+    m[chamberName(k, "coupling.chamber_max_volume_miss")] = c.maxMissRun;
+    m[chamberName(k, "coupling.chamber_volume")] = c.volumeStart;
+    m[chamberName(k, "coupling.chamber_pressure")] = c.pressure;
   }
   const auto& all = timers_.all();
   auto seconds = [&](const char* k) {
@@ -1161,9 +1184,13 @@ void FsiCoupling::saveState(io::StateWriter& w) const {
                                         double(l.limited), stepEnd_, forceResidual_, minJacobian_});
   w.put("counters", std::vector<std::int64_t>{steps_, iterationsTotal_, unconvergedSteps_, unconvergedInARow_,
                                               cutBacksTotal_, limitedTotal_, maxIterations_});
-  if (chamber_.panel >= 0)
-    w.put("chamber", std::vector<double>{chamber_.volumeStart, chamber_.sweptLast, chamber_.maxMissRun, l.volumeStep,
-                                         l.volumeMiss, l.chamberPressure});
+  // The first chamber's as "chamber" (the checkpoints of a single chamber), the others' as
+  // "chamber1", "chamber2", ...
+  for (std::size_t k = 0; k < chambers_.size(); ++k) {
+    const Chamber& c = chambers_[k];
+    w.put(k == 0 ? std::string("chamber") : "chamber" + std::to_string(k),
+          std::vector<double>{c.volumeStart, c.sweptLast, c.maxMissRun, c.volumeStep, c.volumeMiss, c.pressure});
+  }
 }
 
 void FsiCoupling::loadState(const io::StateReader& r) {
@@ -1217,14 +1244,12 @@ void FsiCoupling::loadState(const io::StateReader& r) {
   cutBacksTotal_ = c[4];
   limitedTotal_ = c[5];
   maxIterations_ = static_cast<int>(c[6]);
-  if (chamber_.panel >= 0) {
-    const auto ch = r.doubles("chamber", 6);
-    chamber_.volumeStart = ch[0];
-    chamber_.sweptLast = ch[1];
-    chamber_.maxMissRun = ch[2];
-    l.volumeStep = ch[3];
-    l.volumeMiss = ch[4];
-    l.chamberPressure = ch[5];
+  for (std::size_t k = 0; k < chambers_.size(); ++k) {
+    Chamber& c = chambers_[k];
+    const auto ch = r.doubles(k == 0 ? std::string("chamber") : "chamber" + std::to_string(k), 6);
+    double* to[6] = {&c.volumeStart, &c.sweptLast, &c.maxMissRun, &c.volumeStep, &c.volumeMiss, &c.pressure};
+    for (int j = 0; j < 6; ++j) *to[j] = ch[static_cast<std::size_t>(j)];
+    last_.volumeMiss = std::max(last_.volumeMiss, c.volumeMiss);
   }
 }
 

@@ -99,11 +99,9 @@ class FsiCoupling final : public Module {
     int cutBacks = 0;  ///< iterates the mesh could not follow, cut back towards the last good one
     int motionIterations = 0;  ///< CG iterations (or Jacobi sweeps) of the step's mesh motions
     int limited = 0;           ///< updates shortened by maxDeltaDispFrac / maxMeshVelocity
-    /// A closed chamber: the largest |volume change - target| of the step's iterates that the fluid
-    /// saw and the structure returned [m^3], the target's change over the step, and the multiplier.
+    /// Closed chambers: the largest |volume change - target| of the step's iterates that the fluid
+    /// saw and the structure returned, over the chambers [m^3] (each chamber's own: Chamber).
     double volumeMiss = 0;
-    double volumeStep = 0;
-    double chamberPressure = 0;
   };
   const StepReport& lastStep() const { return last_; }
 
@@ -171,10 +169,10 @@ class FsiCoupling final : public Module {
   /// The membranes (and bodies) to the iterate x; a membrane that closes a chamber first moves x
   /// onto its volume constraint (x is updated).
   void setTrial(coupling::InterfaceVector& x);
-  /// A closed chamber: the step's volume target from the prescribed inflow and the fluid's
+  /// Closed chambers: each step's volume target from the prescribed inflow and the fluid's
   /// mesh-flux weights.
   void beginChamberStep();
-  /// |volume change - target| of the chamber membrane at its slice of x, into the step's report.
+  /// |volume change - target| of each chamber's membrane at its slice of x, into the step's report.
   void checkChamberVolume(const coupling::InterfaceVector& x);
   void commitStructure();
   /// maxDeltaDispFrac and maxMeshVelocity: x's move from `previous` is shortened where it exceeds
@@ -195,9 +193,15 @@ class FsiCoupling final : public Module {
   void setUpParents(const SceneConfig& section);
   void setUpChamber(const SceneConfig& section);
   void setUpLumpedChamber(const SceneConfig& section);
-  /// Panel `panel` closes the chamber (sign: MembraneVolumeConstraint::sign): its constraint is
+  /// Panel `panel` closes a new chamber (sign: MembraneVolumeConstraint::sign; fluidRegion: the
+  /// fluid's closed region, -1 for the whole domain or a lumped chamber): its constraint is
   /// switched on at the volume it has now.
-  void activateChamber(int panel, real sign);
+  void addChamber(int panel, real sign, int fluidRegion, bool lumped);
+  /// The chamber panel `panel` closes, or -1.
+  int chamberOf(int panel) const;
+  /// A chamber's column or metric name: `name` alone with one chamber, `name` + "." + its
+  /// membrane's name with several.
+  std::string chamberName(std::size_t chamber, const std::string& name) const;
   /// The coupled membranes' names as the scene spells them ("<name>" of module "membrane.<name>").
   std::vector<std::string> membraneNames() const;
 
@@ -234,16 +238,21 @@ class FsiCoupling final : public Module {
             limitedTotal_ = 0;
   int maxIterations_ = 0;
   double minJacobian_ = 1;
-  /// The membrane that closes a closed fluid domain, and the volume bookkeeping of its constraint.
+  /// A membrane that closes a closed fluid region (or the whole closed domain, or a lumped gas
+  /// chamber behind it), and the volume bookkeeping of its constraint. One per closed region.
   struct Chamber {
-    int panel = -1;            ///< index into panels_; -1: no constraint
+    int panel = -1;            ///< index into panels_
     int fluidRegion = -1;      ///< the fluid's closed region (FluidSolver::addClosedRegion); -1: the whole domain
     bool lumped = false;       ///< an unmeshed gas chamber behind the membrane (coupling.lumpedChamber)
     double volumeStart = 0;    ///< the chamber's volume change where the fluid mesh is at the step's start
     double sweptLast = 0;      ///< what the membrane swept in the last step (the BDF2 mesh flux reads it)
     double maxMissRun = 0;     ///< largest volume miss of the run [m^3]
+    // This step's:
+    double volumeStep = 0;     ///< the target's change over the step [m^3]
+    double volumeMiss = 0;     ///< largest |volume change - target| of its iterates [m^3]
+    double pressure = 0;       ///< the chamber's pressure [Pa]
   };
-  Chamber chamber_;
+  std::vector<Chamber> chambers_;
 };
 
 /// Catalogue entry of the `coupling` section (needs the `fluid` section and at least one membrane

@@ -213,6 +213,19 @@ TEST(FsiScene, CouplingInputErrorsNameTheKey) {
   EXPECT_NE(e.find("viscosity"), std::string::npos) << e;
 }
 
+TEST(FsiScene, ClosedChambersThatHaveNoAnswerAreInputErrors) {
+  // Two balloons side by side under an open chamber: each closed region has its own membrane.
+  const std::string scene = std::string(MFSI_TEST_DATA_DIR) + "/balloon_side_by_side.yaml";
+  EXPECT_EQ(mfsi::test::sceneInputError(scene, {}), "");
+  // The open chamber closed too: three regions and no pressure boundary anywhere.
+  std::string e = mfsi::test::sceneInputError(scene, {"fluid.boundary.outlet.type=wall"});
+  EXPECT_NE(e.find("3 regions and no pressure boundary"), std::string::npos) << e;
+  EXPECT_NE(e.find("volumeConstraint"), std::string::npos) << e;
+  // The divider half as high: the two chambers are one region, bounded by two membranes.
+  e = mfsi::test::sceneInputError(scene, {"mesh.baffles.2.max=[1, 0.5, 0.05]"});
+  EXPECT_NE(e.find("bounded by two membranes (membrane.topA and membrane.topB)"), std::string::npos) << e;
+}
+
 TEST(FsiScene, WithoutACouplingSectionNothingIsCoupled) {
   const int before = mfsi::Module::constructionCounts().count("coupling")
                          ? mfsi::Module::constructionCounts().at("coupling")
