@@ -58,7 +58,9 @@ def main():
     # The blood chamber's volume mean where the blood is the whole fluid (cases/vad.yaml); with the
     # air meshed too (cases/vad-two-chambers.yaml) the pressure at the blood chamber's middle.
     blood_column = "fluid.meanPressure" if "fluid.meanPressure" in c else "fluid.probe.blood"
-    blood_label = "blood chamber (volume mean)" if blood_column == "fluid.meanPressure" else "blood chamber (middle)"
+    blood_mean = blood_column == "fluid.meanPressure"
+    blood_label = "blood chamber (volume mean)" if blood_mean else "blood chamber (middle)"
+    jump_label = "air − blood mean" if blood_mean else "air − blood (middle)"
     p_blood = [p / MMHG for p in c[blood_column]]
     p_out = [p / MMHG for p in c["fluid.bloodOutlet.pressure"]]
     w_mm = [1000 * w for w in c["membrane.membrane.centreDeflection"]]
@@ -69,7 +71,7 @@ def main():
     print("status: %s %s" % (summary["status"], summary.get("error") or ""))
     print("reached t = %.3f s (%d steps of %.4g s), wall %.0f s" % (t[-1], n, dt, summary["wall_s"]))
     print("| cycle | from–to [s] | wall [s] | FSI its/step (max) | min scaled Jacobian | centre [mm] | "
-          "outlet p, ejection [mmHg] | air − blood mean p [mmHg] | membrane's volume miss [mL] | blood out − swept, per step [mL] | air in − blood out at the end [mL] |")
+          "outlet p, ejection [mmHg] | " + jump_label + " p [mmHg] | membrane's volume miss [mL] | blood out − swept, per step [mL] | air in − blood out at the end [mL] |")
     print("|---|---|---|---|---|---|---|---|---|---|---|")
     k = 0
     while k * a.period < t[-1] - 1e-9:
@@ -104,7 +106,7 @@ def main():
         ax[1][0].set_ylabel("volume since t = 0 [mL]")
         ax[1][0].legend(fontsize=8)
         ax[1][1].plot(t, [p_air[i] - p_blood[i] for i in range(n)])
-        ax[1][1].set_ylabel("air − blood mean pressure [mmHg]")
+        ax[1][1].set_ylabel(jump_label + " pressure [mmHg]")
         ax[2][0].plot(t, jac)
         ax[2][0].set_ylabel("min scaled Jacobian")
         ax[2][0].set_xlabel("t [s]")
