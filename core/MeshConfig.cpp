@@ -127,7 +127,7 @@ Schema meshSchema() {
            Presence::OptionalSection)
       .key("baffles", Schema::list("baffles declared on grid planes (blocks only)", baffleSchema()),
            Presence::Optional)
-      .key("file", Schema::string("Gmsh .msh 4.1 file or OpenFOAM polyMesh folder, relative to the scene"),
+      .key("file", Schema::path("Gmsh .msh 4.1 file or OpenFOAM polyMesh folder, relative to the scene"),
            Presence::OptionalSection)
       .key("format", Schema::choice("mesh file format", {"auto", "gmsh", "polyMesh"}), Default("auto"))
       .key("patchTypes", Schema::freeMap("kind per patch name", Schema::choice("patch kind", {"patch", "wall", "symmetry", "empty"})),

@@ -135,20 +135,24 @@ void applyOverride(ConfigNode& root, const Schema& schema, const std::string& ar
   node->keyLoc = src;
 }
 
-void emit(YAML::Emitter& e, const ConfigNode& n, bool commentDefaults) {
+/// `n` as YAML; a path (Schema::path) made absolute against `base`, the scene file's folder.
+void emit(YAML::Emitter& e, const ConfigNode& n, bool commentDefaults, const std::filesystem::path& base) {
   switch (n.kind) {
     case ConfigNode::Kind::Null:
       e << YAML::Null;
       break;
     case ConfigNode::Kind::Scalar:
-      e << n.text;
+      if (n.schema && n.schema->isPath() && !n.text.empty() && std::filesystem::path(n.text).is_relative())
+        e << std::filesystem::absolute(base / n.text).lexically_normal().string();
+      else
+        e << n.text;
       break;
     case ConfigNode::Kind::List: {
       const bool flat = std::all_of(n.items.begin(), n.items.end(),
                                     [](const ConfigNode& c) { return c.kind == ConfigNode::Kind::Scalar; });
       if (flat || n.items.empty()) e << YAML::Flow;
       e << YAML::BeginSeq;
-      for (const auto& c : n.items) emit(e, c, commentDefaults);
+      for (const auto& c : n.items) emit(e, c, commentDefaults, base);
       e << YAML::EndSeq;
       break;
     }
@@ -157,7 +161,7 @@ void emit(YAML::Emitter& e, const ConfigNode& n, bool commentDefaults) {
       e << YAML::BeginMap;
       for (const auto& c : n.items) {
         e << YAML::Key << c.name << YAML::Value;
-        emit(e, c, commentDefaults);
+        emit(e, c, commentDefaults, base);
         const bool leaf = c.kind == ConfigNode::Kind::Scalar || c.items.empty() ||
                           (c.schema && c.schema->kind() == Schema::Kind::Vector);
         if (commentDefaults && c.defaulted && leaf) e << YAML::Comment("default");
@@ -267,7 +271,7 @@ SourceLocation SceneConfig::where(const std::string& path) const {
 
 std::string SceneConfig::resolvedYaml(bool commentDefaults) const {
   YAML::Emitter e;
-  emit(e, *node_, commentDefaults);
+  emit(e, *node_, commentDefaults, std::filesystem::path(file()).parent_path());
   return std::string(e.c_str()) + "\n";
 }
 

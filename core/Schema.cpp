@@ -87,6 +87,12 @@ Schema Schema::integer(std::string doc, std::string units) {
 }
 Schema Schema::boolean(std::string doc) { return leaf(Kind::Scalar, ScalarType::Bool, std::move(doc), "", 0); }
 Schema Schema::string(std::string doc) { return leaf(Kind::Scalar, ScalarType::String, std::move(doc), "", 0); }
+
+Schema Schema::path(std::string doc) {
+  Schema s = leaf(Kind::Scalar, ScalarType::String, std::move(doc), "", 0);
+  s.path_ = true;
+  return s;
+}
 Schema Schema::choice(std::string doc, std::vector<std::string> choices) {
   Schema s = leaf(Kind::Scalar, ScalarType::Enum, std::move(doc), "", 0);
   s.choices_ = std::move(choices);

@@ -97,6 +97,10 @@ class Schema {
   static Schema integer(std::string doc, std::string units = "-");
   static Schema boolean(std::string doc);
   static Schema string(std::string doc);
+  /// A file or folder path, relative to the scene file's folder when not absolute: a string that
+  /// SceneConfig::resolvedYaml writes absolute, so a copy of the scene elsewhere (a run's
+  /// scene.yaml) names the same file.
+  static Schema path(std::string doc);
   static Schema choice(std::string doc, std::vector<std::string> choices);
   static Schema realVector(int n, std::string doc, std::string units);
   static Schema intVector(int n, std::string doc, std::string units = "-");
@@ -115,6 +119,7 @@ class Schema {
 
   Kind kind() const { return kind_; }
   ScalarType scalarType() const { return type_; }
+  bool isPath() const { return path_; }
   const std::string& doc() const { return doc_; }
   const std::string& units() const { return units_; }
   const std::vector<Key>& keys() const { return keys_; }
@@ -147,6 +152,7 @@ class Schema {
   std::shared_ptr<const Schema> item_;
   int minLength_ = 0;
   int size_ = 0;
+  bool path_ = false;
   std::vector<std::string> choices_;
   Bounds bounds_;
 };

@@ -69,7 +69,7 @@ Schema meshSchemaOfPanel() {
                       .key("radius", Schema::real("radius", "m").greaterThan(0), Default(s.radius))
                       .key("faceCells", Schema::integer("cells per cube-face side").atLeast(1), Default(s.n));
   Schema gmsh = Schema::map("surface mesh from a Gmsh 4.1 ASCII file (quads and/or triangles; line groups become node sets)")
-                    .key("file", Schema::string("Gmsh .msh file, relative to the scene"))
+                    .key("file", Schema::path("Gmsh .msh file, relative to the scene"))
                     .key("group", Schema::string("physical surface group (empty: all surface elements)"), Default(""));
   Schema baffles = Schema::map("surface taken from a baffle of the scene's fluid mesh (nodes shared with the fluid)")
                        .key("patch", Schema::string("baffle name (mesh.baffles name, without _master/_slave)"));

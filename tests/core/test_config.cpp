@@ -5,6 +5,7 @@
 #include "core/Schema.hpp"
 #include "support/Approx.hpp"
 
+#include <filesystem>
 #include <gtest/gtest.h>
 
 #include <array>
@@ -287,6 +288,25 @@ TEST(SceneConfig, OverrideErrors) {
   // The section created by --set misses its required key: the error names the override.
   EXPECT_CONTAINS(errorOf(kMinimal, {"fluid.density=2"}),
                   "--set fluid.density=2: key 'fluid.viscosity': missing required key");
+}
+
+TEST(SceneConfig, ResolvedYamlWritesPathsAbsolute) {
+  // A path relative to the scene's folder is written absolute (a run's copy of its scene, in its
+  // output folder, names the same file); an absolute one and a plain string stay as they are.
+  const Schema schema = Schema::map("scene")
+                            .key("mesh", Schema::path("a file"))
+                            .key("other", Schema::path("another"))
+                            .key("name", Schema::string("a name"));
+  const auto cfg = SceneConfig::fromString("mesh: meshes/a.msh\nother: /data/b.msh\nname: meshes/c\n",
+                                           "/some/where/scene.yaml", schema);
+  const std::string yaml = cfg.resolvedYaml(false);
+  EXPECT_CONTAINS(yaml, "mesh: /some/where/meshes/a.msh");
+  EXPECT_CONTAINS(yaml, "other: /data/b.msh");
+  EXPECT_CONTAINS(yaml, "name: meshes/c");
+  // A scene named relative to the working directory: absolute against it.
+  const auto rel = SceneConfig::fromString("mesh: ../m.msh\nother: x\nname: n\n", "cases/s.yaml", schema);
+  EXPECT_CONTAINS(rel.resolvedYaml(false),
+                  "mesh: " + (std::filesystem::current_path() / "m.msh").lexically_normal().string());
 }
 
 TEST(SceneConfig, ResolvedYamlRoundTrips) {
