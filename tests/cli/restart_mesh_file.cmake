@@ -3,6 +3,7 @@
 # then comes from the run's copy, <out>/scene.yaml, which names the mesh by its absolute path
 # (Schema::path). The continued steps are the uninterrupted run's, bit for bit (the wall time left
 # out).
+include(${CMAKE_CURRENT_LIST_DIR}/support/summary.cmake)
 file(REMOVE_RECURSE ${WORK})
 execute_process(COMMAND ${MFSI} run ${CASES}/vad-two-chambers.yaml --set time.endTime=0.004
   --set output.checkpoint.everySteps=2 --out ${WORK}/whole RESULT_VARIABLE rc OUTPUT_QUIET ERROR_VARIABLE e)
@@ -18,12 +19,8 @@ execute_process(COMMAND ${MFSI} run --restart ${WORK}/whole/checkpoints/checkpoi
 if(NOT rc EQUAL 0)
   message(FATAL_ERROR "the restart failed (${rc}): ${e}")
 endif()
-file(STRINGS ${WORK}/whole/steps.csv a)
-file(STRINGS ${WORK}/continued/steps.csv b)
-list(GET a -1 la)
-list(GET b -1 lb)
-string(REGEX REPLACE "^([^,]*,[^,]*,)[^,]*" "\\1" la "${la}")
-string(REGEX REPLACE "^([^,]*,[^,]*,)[^,]*" "\\1" lb "${lb}")
+mfsi_last_step(${WORK}/whole la)
+mfsi_last_step(${WORK}/continued lb)
 if(NOT la STREQUAL lb OR NOT la MATCHES "^4,")
   message(SEND_ERROR "the continued run ends differently:\n${la}\n${lb}")
 endif()

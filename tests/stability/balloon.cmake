@@ -16,6 +16,7 @@
 # With SHORT (the instrumented builds) each run stops half-way through the filling (t = 2 s), the
 # coupling and the volume constraint checked as always, the state at rest not reached.
 include(${CMAKE_CURRENT_LIST_DIR}/lib/Checks.cmake)
+include(${CMAKE_CURRENT_LIST_DIR}/../cli/support/summary.cmake)
 file(REMOVE_RECURSE ${WORK})
 set(membrane top)
 if(SHORT)
@@ -121,12 +122,8 @@ file(COPY ${WORK}/saved/ DESTINATION ${WORK}/continued)
 # The folder's latest checkpoint: step ${restartAt}, the only one written.
 execute_process(COMMAND ${MFSI} run --restart ${WORK}/continued
   --out ${WORK}/continued RESULT_VARIABLE rc2 OUTPUT_QUIET ERROR_VARIABLE e)
-file(STRINGS ${WORK}/saved/steps.csv a)
-file(STRINGS ${WORK}/continued/steps.csv b)
-list(GET a -1 la)
-list(GET b -1 lb)
-string(REGEX REPLACE "^([^,]*,[^,]*,)[^,]*" "\\1" la "${la}")
-string(REGEX REPLACE "^([^,]*,[^,]*,)[^,]*" "\\1" lb "${lb}")
+mfsi_last_step(${WORK}/saved la)
+mfsi_last_step(${WORK}/continued lb)
 if(NOT rc1 EQUAL 0 OR NOT rc2 EQUAL 0 OR NOT la STREQUAL lb OR NOT la MATCHES "^${savedSteps},")
   message(SEND_ERROR "balloon restart from step ${restartAt} (exit ${rc1}, ${rc2}) ends differently:\n${la}\n${lb}\n${e}")
 endif()

@@ -1,4 +1,5 @@
-# Shared by the tests/cli scripts (include()d; not a test of its own: the suite globs tests/cli/*.cmake).
+# Shared by the tests/cli scripts and the stability suite (include()d; not a test of its own: the
+# suite globs tests/cli/*.cmake).
 #
 # mfsi_expect_summary(<dir> <status> <text> <context>)
 # Reads <dir>/summary.json into the caller's summary_status, summary_error, summary_steps and
@@ -18,4 +19,13 @@ function(mfsi_expect_summary dir status text context)
   if(pos EQUAL -1)
     message(SEND_ERROR "${context}: the error message lacks '${text}': ${summary_error}")
   endif()
+endfunction()
+
+# mfsi_last_step(<run dir> <out>): the last row of <run dir>/steps.csv without its wall time (the
+# third column), for comparing runs bit for bit.
+function(mfsi_last_step dir out)
+  file(STRINGS ${dir}/steps.csv rows)
+  list(GET rows -1 last)
+  string(REGEX REPLACE "^([^,]*,[^,]*,)[^,]*" "\\1" last "${last}")
+  set(${out} "${last}" PARENT_SCOPE)
 endfunction()
