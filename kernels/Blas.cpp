@@ -50,8 +50,8 @@ void spmv(const ExecSpace& exec, const CsrMatrix& A, const ConstRealView& x, con
 }
 
 void spmv(const ExecSpace& exec, real alpha, const CsrMatrix& A, const ConstRealView& x, real beta, const RealView& y) {
-  detail::spmvRows(exec, "mfsi::kernels::blas::spmv", alpha, A.nRows, A.runs, A.rowPtr, A.colIdx, ConstRealView(A.values),
-                   x, beta, y);
+  detail::spmvRows(exec, "mfsi::kernels::blas::spmv", alpha, A.nRows, A.runs, A.rowPtr, A.colIdx,
+                   ConstRealView(A.values), x, beta, y);
 }
 
 double spmvDot(const ExecSpace& exec, const SolverComm& comm, const CsrMatrix& A, const ConstRealView& x,

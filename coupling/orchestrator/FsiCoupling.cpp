@@ -279,12 +279,11 @@ void FsiCoupling::setUpChamber(const SceneConfig& section) {
       if (p.mounted)
         throw InputError(where, p.module->name() + " closes a fluid region on moving bodies: a volume constraint "
                                 "for a mounted membrane is not supported yet");
-      if (chamberOf(static_cast<int>(i)) >= 0)
-        throw InputError(where, p.module->name() + " closes two chambers (" +
-                                    (chambers_[chamberOf(static_cast<int>(i))].lumped ? "a lumped one and "
-                                                                                       : "fluid regions on both sides, ") +
-                                    "a fluid region): one volume constraint per membrane; give one of them a "
-                                    "pressure boundary");
+      if (const int k = chamberOf(static_cast<int>(i)); k >= 0) {
+        const std::string other = chambers_[static_cast<std::size_t>(k)].lumped ? "a lumped one" : "a fluid region";
+        throw InputError(where, p.module->name() + " closes two chambers (" + other + " and a fluid region): one "
+                                "volume constraint per membrane; give one of them a pressure boundary");
+      }
       panel = static_cast<int>(i);
       sign = front ? 1.0 : -1.0;
     }

@@ -224,6 +224,10 @@ TEST(FsiScene, ClosedChambersThatHaveNoAnswerAreInputErrors) {
   // The divider half as high: the two chambers are one region, bounded by two membranes.
   e = mfsi::test::sceneInputError(scene, {"mesh.baffles.2.max=[1, 0.5, 0.05]"});
   EXPECT_NE(e.find("bounded by two membranes (membrane.topA and membrane.topB)"), std::string::npos) << e;
+  // A lumped chamber behind a membrane whose fluid side is closed too: two constraints on one membrane.
+  e = mfsi::test::sceneInputError(std::string(MFSI_TEST_DATA_DIR) + "/balloon_lumped.yaml",
+                                  {"fluid.boundary.outlet.type=wall"});
+  EXPECT_NE(e.find("membrane.top closes two chambers (a lumped one and a fluid region)"), std::string::npos) << e;
 }
 
 TEST(FsiScene, WithoutACouplingSectionNothingIsCoupled) {
