@@ -209,7 +209,11 @@ std::vector<std::string> FluidModule::stepColumns() const {
     columns.push_back(p + ".flowRate");
     columns.push_back(p + ".pressure");
   }
-  if (reports_.meanPressure) columns.push_back("meanPressure");
+  if (reports_.meanPressure) {
+    // With fluid regions, each fluid's own: the options' fluid, then each region's by its patch.
+    columns.push_back("meanPressure");
+    for (const fluid::FluidRegion& r : solver_.options().regions) columns.push_back("meanPressure." + r.patch);
+  }
   return columns;
 }
 
@@ -235,7 +239,15 @@ void FluidModule::appendStepValues(std::vector<double>& v) const {
     const PatchFlow f = patchFlow(solver_, p);
     v.insert(v.end(), {f.flowRate, f.meanPressure});
   }
-  if (reports_.meanPressure) v.push_back(meanPressure(solver_));
+  if (reports_.meanPressure) {
+    if (solver_.options().regions.empty()) {
+      v.push_back(meanPressure(solver_));
+    } else {
+      v.push_back(meanPressure(solver_, -1));
+      for (std::size_t i = 0; i < solver_.options().regions.size(); ++i)
+        v.push_back(meanPressure(solver_, static_cast<int>(i)));
+    }
+  }
 }
 
 GhiaErrors FluidModule::ghiaCheck() const {

@@ -347,7 +347,8 @@ Schema fluidSchema() {
            Presence::Optional)
       .key("meanPressure",
            Schema::boolean("write the volume-weighted mean pressure every step (steps.csv column "
-                           "fluid.meanPressure)"),
+                           "fluid.meanPressure; with regions, that of the cells no region names and "
+                           "fluid.meanPressure.<patch> each region's)"),
            Default(false))
       .key("ghia",
            Schema::map("compare a lid-driven cavity (mesh bounding box in x, y; lid at y max moving in +x) with "

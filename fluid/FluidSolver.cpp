@@ -947,15 +947,19 @@ void FluidSolver::setUpRegions(const RankDomain& domain) {
   }
   cellFluid_.rho = RealView("mfsi::fluid::cellDensity", nCells_);
   cellFluid_.mu = RealView("mfsi::fluid::cellViscosity", nCells_);
+  cellFluid_.index = IndexView("mfsi::fluid::cellFluid", nCells_);
   auto rho = Kokkos::create_mirror_view(cellFluid_.rho);
   auto mu = Kokkos::create_mirror_view(cellFluid_.mu);
+  auto index = Kokkos::create_mirror_view(cellFluid_.index);
   for (lid_t c = 0; c < nCells_; ++c) {
     const int f = fluidOf[static_cast<std::size_t>(regions.cellRegion[static_cast<std::size_t>(c)])];
     rho(c) = f < 0 ? opt_.density : opt_.regions[static_cast<std::size_t>(f)].density;
     mu(c) = f < 0 ? opt_.viscosity : opt_.regions[static_cast<std::size_t>(f)].viscosity;
+    index(c) = f;
   }
   Kokkos::deep_copy(cellFluid_.rho, rho);
   Kokkos::deep_copy(cellFluid_.mu, mu);
+  Kokkos::deep_copy(cellFluid_.index, index);
 }
 
 // ------------------------------------------------------------------------------------------------

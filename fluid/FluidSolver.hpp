@@ -153,6 +153,9 @@ class FluidSolver {
   /// \brief Each cell's dynamic viscosity [Pa s] when FluidOptions::regions gives some cells another
   /// fluid; an empty view when every cell has options().viscosity.
   ConstRealView cellViscosity() const { return cellFluid_.mu; }
+  /// \brief Each cell's fluid (-1: the options' own, i: FluidOptions::regions[i]); an empty view
+  /// without regions.
+  ConstIndexView cellFluidIndex() const { return cellFluid_.index; }
   /// The ghost cells' halo (null on one rank).
   const Halo* cellHalo() const { return cellHalo_.get(); }
   /// Number of `beginStep` calls so far.
@@ -300,6 +303,7 @@ class FluidSolver {
   /// views otherwise (the kernels then read opt_.density and opt_.viscosity).
   struct CellFluid {
     RealView rho, mu;
+    IndexView index;  ///< which fluid: -1 the options' own, i FluidOptions::regions[i]
     bool perCell() const { return rho.extent(0) > 0; }
   };
   CellFluid cellFluid_;

@@ -42,6 +42,9 @@ PatchFlow patchFlow(const FluidSolver& fluid, const std::string& patch);
 
 /// \brief Volume-weighted mean of the cell pressure over the fluid [Pa].
 real meanPressure(const FluidSolver& fluid);
+/// \brief The same over the cells of one fluid (FluidSolver::cellFluidIndex: -1 the options' own,
+/// i FluidOptions::regions[i]).
+real meanPressure(const FluidSolver& fluid, int which);
 
 /// \brief Net pressure across a baffle per face pair: pNet(i) = p(master face i) - p(slave face i)
 /// [Pa]. The master's outward normal is the baffle normal, so the pressure load on the membrane is
