@@ -11,7 +11,7 @@ namespace {
 
 /// The cells' components through the mesh's internal faces (union-find with path halving): per
 /// cell, the index of its component's root cell.
-std::vector<lid_t> components(const HexMesh& mesh) {
+std::vector<lid_t> cellComponents(const HexMesh& mesh) {
   const lid_t nCells = mesh.nCells(), nIn = mesh.nInternalFaces();
   auto own = Kokkos::create_mirror_view_and_copy(HostSpace(), mesh.faceOwner());
   auto nbr = Kokkos::create_mirror_view_and_copy(HostSpace(), mesh.faceNeighbour());
@@ -30,7 +30,7 @@ std::vector<lid_t> components(const HexMesh& mesh) {
 }
 
 /// Every cell's label <- the least label in its component; true when one changed.
-bool spread(const std::vector<lid_t>& component, std::vector<double>& label) {
+bool spreadLeastLabel(const std::vector<lid_t>& component, std::vector<double>& label) {
   std::vector<double> least(label.size(), 0);
   for (std::size_t c = 0; c < label.size(); ++c) least[c] = label[c];
   for (std::size_t c = 0; c < label.size(); ++c)
@@ -53,16 +53,16 @@ MeshRegions findMeshRegions(const HexMesh& mesh, const std::vector<std::string>&
   // A region is named by its cell of least global id. On a rank's part a region may leave the part
   // and come back, or be joined through other ranks' cells: the labels travel through the cell
   // halo (each ghost's into its owner, the owner's back to every copy) until no rank's change.
-  const std::vector<lid_t> component = components(mesh);
+  const std::vector<lid_t> component = cellComponents(mesh);
   std::vector<double> label(static_cast<std::size_t>(nCells));
   for (lid_t c = 0; c < nCells; ++c) label[c] = static_cast<double>(gid(c));  // exact below 2^53
-  spread(component, label);
+  spreadLeastLabel(component, label);
   if (domain.distributed()) {
     for (;;) {
       foldGhostsIntoOwners(domain.comm, domain.cells, 1, label,
                            [&label](lid_t c, const double* copy) { label[c] = std::min(label[c], *copy); });
       copyOwnersToGhosts(domain.comm, domain.cells, 1, label);
-      int changed = spread(component, label) ? 1 : 0;
+      int changed = spreadLeastLabel(component, label) ? 1 : 0;
       MPI_Allreduce(MPI_IN_PLACE, &changed, 1, MPI_INT, MPI_MAX, domain.comm);
       if (changed == 0) break;
     }
