@@ -243,9 +243,10 @@ void FluidModule::appendStepValues(std::vector<double>& v) const {
     if (solver_.options().regions.empty()) {
       v.push_back(meanPressure(solver_));
     } else {
-      v.push_back(meanPressure(solver_, -1));
+      const ConstIndexView fluidOf = solver_.cellFluidIndex();
+      v.push_back(meanPressure(solver_, fluidOf, -1));
       for (std::size_t i = 0; i < solver_.options().regions.size(); ++i)
-        v.push_back(meanPressure(solver_, static_cast<int>(i)));
+        v.push_back(meanPressure(solver_, fluidOf, static_cast<int>(i)));
     }
   }
 }

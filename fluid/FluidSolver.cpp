@@ -929,37 +929,39 @@ ConstTensor3View FluidSolver::velocityGradient() const {
 }
 
 void FluidSolver::setUpRegions(const RankDomain& domain) {
-  std::vector<std::string> patches;
-  for (const FluidRegion& r : opt_.regions) patches.push_back(r.patch);
-  const MeshRegions regions = findMeshRegions(mesh_, patches, domain);
-  // Each region's fluid: the entry whose patch has a face in it. Every rank asks every patch alone
-  // (the regions are the whole mesh's on every rank).
-  std::vector<int> fluidOf(static_cast<std::size_t>(regions.count), -1);
-  for (std::size_t i = 0; i < opt_.regions.size(); ++i) {
-    const MeshRegions one = findMeshRegions(mesh_, {opt_.regions[i].patch}, domain);
-    for (int r = 0; r < one.count; ++r) {
-      if (one.closed[static_cast<std::size_t>(r)]) continue;
-      int& f = fluidOf[static_cast<std::size_t>(r)];
-      MFSI_CHECK(f < 0, "fluid: patches '" << opt_.regions[static_cast<std::size_t>(f)].patch << "' and '"
-                                           << opt_.regions[i].patch << "' (fluid.regions) lie in one region");
-      f = static_cast<int>(i);
+  const MeshRegions regions = findMeshRegions(mesh_, {}, domain);
+  const std::size_t nRegions = static_cast<std::size_t>(regions.count), nFluids = opt_.regions.size();
+  // reached[i * nRegions + r] > 0: a face of entry i's patch lies in region r (on some rank: the
+  // regions are the whole mesh's, numbered alike on every rank).
+  std::vector<double> reached(nFluids * nRegions, 0.0);
+  auto own = Kokkos::create_mirror_view_and_copy(HostSpace(), mesh_.faceOwner());
+  for (std::size_t i = 0; i < nFluids; ++i)
+    for (const Patch& p : mesh_.patches())
+      if (p.name == opt_.regions[i].patch)
+        for (lid_t f = p.start; f < p.start + p.size; ++f)
+          reached[i * nRegions + static_cast<std::size_t>(regions.cellRegion[static_cast<std::size_t>(own(f))])] = 1;
+  comm_.globalSum(reached.data(), static_cast<int>(reached.size()));
+  // Each region's fluid: the entry whose patch has a face in it.
+  std::vector<int> fluidOf(nRegions, -1);
+  for (std::size_t i = 0; i < nFluids; ++i)
+    for (std::size_t r = 0; r < nRegions; ++r) {
+      if (reached[i * nRegions + r] == 0) continue;
+      MFSI_CHECK(fluidOf[r] < 0, "fluid: patches '" << opt_.regions[static_cast<std::size_t>(fluidOf[r])].patch
+                                                    << "' and '" << opt_.regions[i].patch
+                                                    << "' (fluid.regions) lie in one region");
+      fluidOf[r] = static_cast<int>(i);
     }
+  std::vector<real> rho(static_cast<std::size_t>(nCells_)), mu(rho.size());
+  std::vector<lid_t> index(rho.size());
+  for (std::size_t c = 0; c < rho.size(); ++c) {
+    const int f = fluidOf[static_cast<std::size_t>(regions.cellRegion[c])];
+    rho[c] = f < 0 ? opt_.density : opt_.regions[static_cast<std::size_t>(f)].density;
+    mu[c] = f < 0 ? opt_.viscosity : opt_.regions[static_cast<std::size_t>(f)].viscosity;
+    index[c] = f;
   }
-  cellFluid_.rho = RealView("mfsi::fluid::cellDensity", nCells_);
-  cellFluid_.mu = RealView("mfsi::fluid::cellViscosity", nCells_);
-  cellFluid_.index = IndexView("mfsi::fluid::cellFluid", nCells_);
-  auto rho = Kokkos::create_mirror_view(cellFluid_.rho);
-  auto mu = Kokkos::create_mirror_view(cellFluid_.mu);
-  auto index = Kokkos::create_mirror_view(cellFluid_.index);
-  for (lid_t c = 0; c < nCells_; ++c) {
-    const int f = fluidOf[static_cast<std::size_t>(regions.cellRegion[static_cast<std::size_t>(c)])];
-    rho(c) = f < 0 ? opt_.density : opt_.regions[static_cast<std::size_t>(f)].density;
-    mu(c) = f < 0 ? opt_.viscosity : opt_.regions[static_cast<std::size_t>(f)].viscosity;
-    index(c) = f;
-  }
-  Kokkos::deep_copy(cellFluid_.rho, rho);
-  Kokkos::deep_copy(cellFluid_.mu, mu);
-  Kokkos::deep_copy(cellFluid_.index, index);
+  cellFluid_.rho = toDevice(rho, "mfsi::fluid::cellDensity");
+  cellFluid_.mu = toDevice(mu, "mfsi::fluid::cellViscosity");
+  cellFluid_.index = toDevice(index, "mfsi::fluid::cellFluid");
 }
 
 // ------------------------------------------------------------------------------------------------
@@ -1779,22 +1781,6 @@ real FluidSolver::prescribedInflow(int region) const {
       },
       q);
   return comm_.globalSum(q);
-}
-
-real FluidSolver::meanPressure(int region) const {
-  ConstIndexView cr = cellClosedRegion_;
-  ConstRealView V = geo_.cellVolume, pc = p_;
-  real r[2] = {0, 0};
-  Kokkos::parallel_reduce(
-      "mfsi::fluid::regionMeanPressure", RangePolicy(exec_, 0, nRows_),
-      KOKKOS_LAMBDA(lid_t c, real & pV, real & sumV) {
-        if (region >= 0 && cr(c) != region) return;
-        pV += pc(c) * V(c);
-        sumV += V(c);
-      },
-      r[0], r[1]);
-  comm_.globalSum(r, 2);
-  return r[1] > 0 ? r[0] / r[1] : 0;
 }
 
 bool FluidSolver::compressible() const {

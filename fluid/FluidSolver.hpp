@@ -156,6 +156,8 @@ class FluidSolver {
   /// \brief Each cell's fluid (-1: the options' own, i: FluidOptions::regions[i]); an empty view
   /// without regions.
   ConstIndexView cellFluidIndex() const { return cellFluid_.index; }
+  /// \brief Each cell's closed region (addClosedRegion; -1: none); an empty view without them.
+  ConstIndexView cellClosedRegion() const { return cellClosedRegion_; }
   /// The ghost cells' halo (null on one rank).
   const Halo* cellHalo() const { return cellHalo_.get(); }
   /// Number of `beginStep` calls so far.
@@ -182,9 +184,6 @@ class FluidSolver {
   /// cells, boundary faces and the level its reference cell is pinned at. Nothing else changes
   /// (the level is free there); a coupling ties it to the multiplier of a volume constraint.
   void shiftPressureLevel(int region, real delta);
-  /// \brief The volume-weighted mean pressure of closed region `region` (addClosedRegion; -1: all
-  /// cells) [Pa], over the ranks.
-  real meanPressure(int region) const;
   /// The level a closed domain (-1) or region is pinned at [Pa].
   real pressureLevel(int region) const;
   /// True when no boundary face prescribes the pressure and the fluid is incompressible: the

@@ -8,8 +8,6 @@ namespace mfsi::fluid {
 
 namespace {
 
-constexpr int kAllFluids = -2;  ///< meanPressure over every cell
-
 void tractionRange(const FluidSolver& fluid, lid_t start, lid_t size, const Real3View& tp, const Real3View& tv) {
   const HexMesh& mesh = fluid.mesh();
   const lid_t nIn = mesh.nInternalFaces();
@@ -123,18 +121,17 @@ PatchFlow patchFlow(const FluidSolver& fluid, const std::string& patch) {
   return {r[0], r[2] > 0 ? r[1] / r[2] : 0, r[2]};
 }
 
-real meanPressure(const FluidSolver& fluid) { return meanPressure(fluid, kAllFluids); }
+real meanPressure(const FluidSolver& fluid) { return meanPressure(fluid, ConstIndexView(), 0); }
 
-real meanPressure(const FluidSolver& fluid, int which) {
+real meanPressure(const FluidSolver& fluid, const ConstIndexView& label, int which) {
   ConstRealView V = fluid.geometry().cellVolume, pc = fluid.pressure();
-  ConstIndexView index = fluid.cellFluidIndex();
-  const bool all = which == kAllFluids || index.extent(0) == 0;
-  MFSI_CHECK(all || which >= -1, "fluid: meanPressure of fluid " << which);
+  const ConstIndexView lab = label;
+  const bool all = label.extent(0) == 0;
   real r[2] = {0, 0};
   Kokkos::parallel_reduce(
       "mfsi::fluid::loads::meanPressure", RangePolicy(ExecSpace(), 0, fluid.ownedCells()),
       KOKKOS_LAMBDA(lid_t c, real & pV, real & sumV) {
-        if (!all && index(c) != which) return;
+        if (!all && lab(c) != which) return;
         pV += pc(c) * V(c);
         sumV += V(c);
       },

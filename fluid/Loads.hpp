@@ -42,9 +42,10 @@ PatchFlow patchFlow(const FluidSolver& fluid, const std::string& patch);
 
 /// \brief Volume-weighted mean of the cell pressure over the fluid [Pa].
 real meanPressure(const FluidSolver& fluid);
-/// \brief The same over the cells of one fluid (FluidSolver::cellFluidIndex: -1 the options' own,
-/// i FluidOptions::regions[i]).
-real meanPressure(const FluidSolver& fluid, int which);
+/// \brief The same over the cells c with label(c) == which (every cell when `label` is empty): one
+/// fluid (FluidSolver::cellFluidIndex: -1 the options' own, i FluidOptions::regions[i]) or one
+/// closed region (FluidSolver::cellClosedRegion).
+real meanPressure(const FluidSolver& fluid, const ConstIndexView& label, int which);
 
 /// \brief Net pressure across a baffle per face pair: pNet(i) = p(master face i) - p(slave face i)
 /// [Pa]. The master's outward normal is the baffle normal, so the pressure load on the membrane is

@@ -329,7 +329,6 @@ void FsiCoupling::checkChamberVolume(const InterfaceVector& x) {
     MembraneSolver& s = p.module->solver();
     copySegmentToDevice(x, p.offset, p.iterate);
     c.volumeMiss = std::max(c.volumeMiss, std::abs(s.enclosedVolume(p.iterate) - s.volumeConstraint().target));
-    last_.volumeMiss = std::max(last_.volumeMiss, c.volumeMiss);
   }
 }
 
@@ -766,8 +765,7 @@ void FsiCoupling::setTrial(InterfaceVector& x) {
         copySegmentToHost(p.iterate, x, p.offset);
         Chamber& c = chambers_[static_cast<std::size_t>(k)];
         c.volumeMiss = std::max(c.volumeMiss, std::abs(s.enclosedVolume(p.iterate) - s.volumeConstraint().target));
-        last_.volumeMiss = std::max(last_.volumeMiss, c.volumeMiss);
-      }
+          }
       s.setTrialDisplacement(p.iterate);
     } else {
       copySegmentToDevice(x, p.offset, s.displacement());
@@ -1000,7 +998,10 @@ void FsiCoupling::advance(const TimeState& t) {
     if (c.lumped) {
       c.pressure = options_.outsidePressure + s.volumeConstraint().lambda;
     } else if (p.iface.side != coupling::InterfaceSide::Patch) {
-      c.pressure = s.volumeConstraint().lambda + fluid_->solver().meanPressure(c.fluidRegion);
+      const fluid::FluidSolver& f = fluid_->solver();
+      const double mean =
+          c.fluidRegion < 0 ? fluid::meanPressure(f) : fluid::meanPressure(f, f.cellClosedRegion(), c.fluidRegion);
+      c.pressure = s.volumeConstraint().lambda + mean;
     } else {
       const std::vector<real>& areas = s.mesh().elementAreas();
       auto h = Kokkos::create_mirror_view_and_copy(HostSpace(), p.load);
@@ -1248,7 +1249,6 @@ void FsiCoupling::loadState(const io::StateReader& r) {
     const auto ch = r.doubles(k == 0 ? std::string("chamber") : "chamber" + std::to_string(k), 6);
     double* to[6] = {&c.volumeStart, &c.sweptLast, &c.maxMissRun, &c.volumeStep, &c.volumeMiss, &c.pressure};
     for (int j = 0; j < 6; ++j) *to[j] = ch[static_cast<std::size_t>(j)];
-    last_.volumeMiss = std::max(last_.volumeMiss, c.volumeMiss);
   }
 }
 

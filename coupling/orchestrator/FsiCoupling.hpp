@@ -99,9 +99,6 @@ class FsiCoupling final : public Module {
     int cutBacks = 0;  ///< iterates the mesh could not follow, cut back towards the last good one
     int motionIterations = 0;  ///< CG iterations (or Jacobi sweeps) of the step's mesh motions
     int limited = 0;           ///< updates shortened by maxDeltaDispFrac / maxMeshVelocity
-    /// Closed chambers: the largest |volume change - target| of the step's iterates that the fluid
-    /// saw and the structure returned, over the chambers [m^3] (each chamber's own: Chamber).
-    double volumeMiss = 0;
   };
   const StepReport& lastStep() const { return last_; }
 

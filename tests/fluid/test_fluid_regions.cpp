@@ -59,8 +59,8 @@ TEST(FluidRegions, EachColumnIsHydrostaticWithItsOwnDensity) {
   for (lid_t f = 0; f < mesh.nFaces(); ++f) EXPECT_NEAR(phi(f), 0.0, 1e-8) << "face " << f;
   EXPECT_EQ(air, mesh.nCells() / 2);
   // Each fluid's volume mean (fluid.meanPressure with regions): rho_i g H / 2.
-  EXPECT_NEAR(meanPressure(fluid, -1), 1000 * 9.81 * 0.5, 1e-6 * 1000 * 9.81);
-  EXPECT_NEAR(meanPressure(fluid, 0), 1.2 * 9.81 * 0.5, 1e-6 * 1.2 * 9.81);
+  EXPECT_NEAR(meanPressure(fluid, fluid.cellFluidIndex(), -1), 1000 * 9.81 * 0.5, 1e-6 * 1000 * 9.81);
+  EXPECT_NEAR(meanPressure(fluid, fluid.cellFluidIndex(), 0), 1.2 * 9.81 * 0.5, 1e-6 * 1.2 * 9.81);
   EXPECT_NEAR(meanPressure(fluid), (1000 + 1.2) * 9.81 * 0.25, 1e-6 * 1000 * 9.81);
 }
 
