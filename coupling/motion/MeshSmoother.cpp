@@ -3,6 +3,7 @@
 #include "core/Error.hpp"
 #include "core/PointTree.hpp"
 #include "core/parallel/SharedNodes.hpp"
+#include "coupling/motion/MeshColumns.hpp"
 
 #include <algorithm>
 #include <array>
@@ -171,6 +172,8 @@ MeshSmoother::MeshSmoother(const HexMesh& mesh, const MeshSmootherOptions& optio
                "mesh motion: a node plan of " << domain.nodes.nLocal << " nodes for a part of " << nn);
     shareRoles(domain, roles);
     nodeHalo_ = std::make_unique<Halo>(domain.comm, domain.nodes);
+    nodePlan_ = domain.nodes;
+    nodeComm_ = domain.comm;
     comm_ = SolverComm(domain.comm, nodeHalo_.get());
   }
   fixed_ = deviceRoles(roles, slide_);
@@ -220,119 +223,73 @@ void MeshSmoother::setMovingNodes(const std::vector<std::array<real, 3>>& points
   cg_ = LaplacianCgWork{};  // the AMG is set up again on the new weights
 }
 
-namespace {
-constexpr double kColumnMargin = M_PI / 6;  ///< how much further off than a column's next edge every other edge is
-}  // namespace
-
-lid_t MeshSmoother::setColumnFeet(const std::vector<lid_t>& feet) {
+lid_t MeshSmoother::setColumnFeet(const std::vector<gid_t>& feet) {
   if (!options_.columns || feet.empty()) return 0;
-  if (nodeHalo_) throw InputError("coupling.meshMotion.columns runs on one rank only");
   auto off = Kokkos::create_mirror_view_and_copy(HostSpace(), mesh_.nodeNodeOffsets());
   auto nb = Kokkos::create_mirror_view_and_copy(HostSpace(), mesh_.nodeNodes());
   auto X = Kokkos::create_mirror_view_and_copy(HostSpace(), mesh_.referencePoints());
+  auto gid = Kokkos::create_mirror_view_and_copy(HostSpace(), mesh_.nodeGlobalIds());
   auto fixed = Kokkos::create_mirror_view_and_copy(HostSpace(), fixed_);
   const lid_t nn = mesh_.nNodes();
-  std::vector<char> foot(nn, 0), claimed(nn, 0), sliding(nn, 0);
+  ColumnGraph g;
+  g.offsets.assign(off.data(), off.data() + nn + 1);
+  g.neighbours.assign(nb.data(), nb.data() + off(nn));
+  g.points.resize(3 * static_cast<std::size_t>(nn));
+  g.fixed.resize(static_cast<std::size_t>(nn));
+  g.sliding.assign(static_cast<std::size_t>(nn), 0);
+  g.gid.resize(static_cast<std::size_t>(nn));
+  for (lid_t i = 0; i < nn; ++i) {
+    for (int c = 0; c < 3; ++c) g.points[3 * i + c] = X(i, c);
+    g.fixed[i] = fixed(i) != 0 ? 1 : 0;
+    g.gid[i] = gid(i);
+  }
   if (slide_.extent(0) > 0) {
     auto sl = Kokkos::create_mirror_view_and_copy(HostSpace(), slide_);
-    for (lid_t i = 0; i < nn; ++i) sliding[i] = (sl(i, 0) != 0 || sl(i, 1) != 0 || sl(i, 2) != 0) ? 1 : 0;
+    for (lid_t i = 0; i < nn; ++i) g.sliding[i] = (sl(i, 0) != 0 || sl(i, 1) != 0 || sl(i, 2) != 0) ? 1 : 0;
   }
-  for (lid_t f : feet) foot.at(f) = 1;
-  auto edge = [&](lid_t a, lid_t b, double e[3]) {
-    double l = 0;
-    for (int c = 0; c < 3; ++c) {
-      e[c] = X(b, c) - X(a, c);
-      l += e[c] * e[c];
-    }
-    l = std::sqrt(l);
-    for (int c = 0; c < 3; ++c) e[c] /= l;
-    return l;
-  };
+  g.nOwned = nodeHalo_ ? nodePlan_.nOwned : nn;
+  if (nodeHalo_) {
+    g.comm = nodeComm_;
+    g.ghostOwner.resize(static_cast<std::size_t>(nn - g.nOwned));
+    for (std::size_t k = 0; k < nodePlan_.neighbours.size(); ++k)
+      for (lid_t i = nodePlan_.recvOffsets[k]; i < nodePlan_.recvOffsets[k + 1]; ++i)
+        g.ghostOwner[i] = nodePlan_.neighbours[k];
+  }
+  const ColumnSet set = findColumns(g, feet);
+  // Each copy of a column node knows its foot and factor: the owner's, copied to the ghosts.
+  std::vector<double> column(2 * static_cast<std::size_t>(nn), -1.0);
+  for (std::size_t k = 0; k < set.node.size(); ++k) {
+    column[2 * set.node[k]] = set.foot[k];
+    column[2 * set.node[k] + 1] = set.weight[k];
+  }
+  if (nodeHalo_) copyOwnersToGhosts(nodeComm_, nodePlan_, 2, column);
   std::vector<lid_t> hNode, hFoot;
   std::vector<real> hWeight;
-  lid_t count = 0;
-  auto trace = [&](lid_t f, lid_t next) {
-    std::vector<lid_t> line{f};
-    std::vector<double> s{0.0};
-    bool ok = true;
-    lid_t prev = f, cur = next;
-    double dir[3];
-    s.push_back(edge(prev, cur, dir));
-    while (ok && !fixed(cur)) {
-      if (claimed[cur] || sliding[cur] || foot[cur] || line.size() > 100000) {
-        ok = false;
-        break;
-      }
-      line.push_back(cur);
-      lid_t best = -1;
-      double bestDot = 0.5, secondDot = -2;
-      for (lid_t k = off(cur); k < off(cur + 1); ++k) {
-        const lid_t m = nb(k);
-        if (m == prev) continue;
-        double e[3];
-        edge(cur, m, e);
-        const double dot = e[0] * dir[0] + e[1] * dir[1] + e[2] * dir[2];
-        if (dot > bestDot) {
-          secondDot = bestDot;
-          bestDot = dot;
-          best = m;
-        } else {
-          secondDot = std::max(secondDot, dot);
-        }
-      }
-      // The line goes on only where that edge is clearly the one: every other edge at least
-      // 30 degrees further off (a layered mesh whose layers slope by up to 60 degrees).
-      if (best < 0 || std::acos(std::min(1.0, secondDot)) < std::acos(std::min(1.0, bestDot)) + kColumnMargin) {
-        ok = false;
-        break;
-      }
-      s.push_back(s.back() + edge(cur, best, dir));
-      prev = cur;
-      cur = best;
-    }
-    if (!ok || line.size() < 2) return;
-    const double total = s.back();  // to the far boundary node `cur`
-    for (std::size_t k = 1; k < line.size(); ++k) {
-      claimed[line[k]] = 1;
-      hNode.push_back(line[k]);
-      hFoot.push_back(f);
-      hWeight.push_back(1 - s[k] / total);
-      fixed(line[k]) = 1;
-    }
-    ++count;
-  };
-  for (lid_t f : feet) {
-    // The edges that leave the surface: one on a boundary patch, one on each side of a baffle
-    // (two that point away from each other); any other foot is left to the Laplacian.
-    std::vector<lid_t> leaving;
-    for (lid_t k = off(f); k < off(f + 1); ++k)
-      if (!foot[nb(k)]) leaving.push_back(nb(k));
-    if (leaving.size() == 2) {
-      double a[3], b[3];
-      edge(f, leaving[0], a);
-      edge(f, leaving[1], b);
-      if (a[0] * b[0] + a[1] * b[1] + a[2] * b[2] > -0.5) continue;
-    } else if (leaving.size() != 1) {
-      continue;
-    }
-    for (lid_t next : leaving) trace(f, next);
+  for (lid_t i = 0; i < nn; ++i) {
+    if (column[2 * i] < 0) continue;
+    hNode.push_back(i);
+    hFoot.push_back(static_cast<lid_t>(column[2 * i]));
+    hWeight.push_back(column[2 * i + 1]);
+    fixed(i) = 1;
   }
   columns_.node = toDevice(hNode, "mfsi::coupling::motion::columnNode");
   columns_.foot = toDevice(hFoot, "mfsi::coupling::motion::columnFoot");
   columns_.weight = toDevice(hWeight, "mfsi::coupling::motion::columnWeight");
+  columns_.feet = Real3View("mfsi::coupling::motion::columnFeet", feet.size());
   Kokkos::deep_copy(fixed_, fixed);
   cg_ = LaplacianCgWork{};  // the AMG is set up again without the column nodes
-  return count;
+  return set.count;
 }
 
 void MeshSmoother::applyColumns(const ExecSpace& exec) const {
   const IndexView node = columns_.node, foot = columns_.foot;
   const RealView w = columns_.weight;
   const Real3View d = d_;
+  const ConstReal3View feet = columns_.feet;
   Kokkos::parallel_for(
       "mfsi::coupling::motion::columns", RangePolicy(exec, 0, static_cast<lid_t>(node.extent(0))),
       KOKKOS_LAMBDA(lid_t i) {
-        for (int c = 0; c < 3; ++c) d(node(i), c) = w(i) * d(foot(i), c);
+        for (int c = 0; c < 3; ++c) d(node(i), c) = w(i) * feet(foot(i), c);
       });
 }
 

@@ -54,7 +54,7 @@ struct MeshSmootherOptions {
   /// Columns (setColumnFeet): the interior nodes of each line of cell edges that leaves a membrane
   /// node and runs layer by layer to another boundary node move with that node, by a factor falling
   /// linearly in reference arc length from 1 at the membrane to 0 at the far wall; the others are
-  /// solved as before, the column nodes prescribed. One rank only.
+  /// solved as before, the column nodes prescribed (coupling/motion/MeshColumns).
   bool columns = false;
 };
 
@@ -91,16 +91,16 @@ class MeshSmoother {
   /// options.distanceExponent > 0 the CG's edge weights grow near them. Call before the first move.
   void setMovingNodes(const std::vector<std::array<real, 3>>& points);
 
-  /// \brief With options.columns: find the columns of nodes above the foot nodes (the membrane's nodes
-  /// on a boundary patch of an extruded, layered mesh, or on a baffle: a column on each side) and
-  /// prescribe their interior nodes. A column
-  /// follows, from each node, the edge best aligned with the previous one (within 60 degrees, and
-  /// every other edge at least 30 degrees further off) until it meets a boundary node; a foot with
-  /// more edges leaving the surface than one (two on a baffle, pointing away from each other), a
-  /// line that turns or has no clear next edge, or that meets a sliding node or another column is
-  /// left to the Laplacian. Returns the number of
-  /// columns. Call before the first move. Throws InputError on a decomposed mesh.
-  lid_t setColumnFeet(const std::vector<lid_t>& feet);
+  /// \brief With options.columns: find the columns of nodes above `feet` (global node ids, the
+  /// same list on every rank: the membranes' nodes on a boundary patch of an extruded, layered mesh,
+  /// or on a baffle, a column on each side; coupling/motion/MeshColumns) and prescribe their interior
+  /// nodes, which then move with their foot's row of `columnFeet()`. Returns the number of columns
+  /// on all ranks. Call before the first move. Collective on a decomposed mesh.
+  lid_t setColumnFeet(const std::vector<gid_t>& feet);
+  /// The feet's displacement, one row per foot in the order `setColumnFeet` was given: set it with
+  /// `displacement()` before each move (on every rank, a foot's row whether or not its node is on
+  /// the rank's part). Empty without columns.
+  Real3View columnFeet() const { return columns_.feet; }
 
   /// Smooth and move the mesh points; the quality guard (the minimum scaled Jacobian, from the
   /// points alone) retries as the options say. The caller recomputes whatever geometry it keeps
@@ -122,7 +122,7 @@ class MeshSmoother {
 
   /// Points = reference + d (one kernel; no fence).
   void place(const ExecSpace& exec, const ConstReal3View& d) const;
-  /// d(node) = weight d(foot) on every column node (one kernel; no fence).
+  /// d(node) = weight columnFeet(foot) on every column node, ghost copies too (one kernel; no fence).
   void applyColumns(const ExecSpace& exec) const;
   /// With a base: d -= base on prescribed nodes; the free ones start from the last remainder.
   void subtractBase(const ExecSpace& exec) const;
@@ -138,12 +138,15 @@ class MeshSmoother {
   Real3View slide_;  ///< unit normal of sliding nodes (zero elsewhere); empty without sliding patches
   /// Columns: node, its foot, its factor (setColumnFeet); empty without columns.
   struct Columns {
-    IndexView node, foot;
+    IndexView node, foot;  ///< every local copy of a column node, and its foot's row of `feet`
     RealView weight;
+    Real3View feet;  ///< columnFeet()
   };
   Columns columns_;
   LaplacianCgWork cg_;
   std::unique_ptr<Halo> nodeHalo_;  ///< decomposed mesh: the ghosts of the displacement
+  HaloPlan nodePlan_;                ///< decomposed mesh: its plan (set-up exchanges on the host)
+  MPI_Comm nodeComm_ = MPI_COMM_NULL;
   SolverComm comm_;
 };
 

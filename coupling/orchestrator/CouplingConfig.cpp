@@ -47,7 +47,7 @@ Schema couplingSchema() {
                Schema::boolean("on a mesh extruded from a membrane patch (layers of cells between it and a wall): "
                                "the nodes of each line of cell edges from a membrane node to the wall move with that "
                                "node, by a factor falling linearly from 1 to 0 along the line, so every layer of the "
-                               "column compresses alike; the other nodes are solved as before. One rank only"),
+                               "column compresses alike; the other nodes are solved as before"),
                Default(false))
           .key("slidingPatches",
                Schema::list("patches whose nodes slide along them (flat walls next to a membrane)",

@@ -146,11 +146,14 @@ FsiCoupling::FsiCoupling(const CouplingOptions& options, const SceneConfig& sect
     smoother_->setMovingNodes(moving);
   }
   if (options_.motion.columns) {
-    if (domain_.distributed())
-      throw InputError(section.where("meshMotion.columns"), "columns run on one rank only");
-    std::vector<lid_t> feet;  // one rank: a node's global id is its index
-    for (const Panel& p : panels_)
-      for (gid_t v : p.module->fluidSurface()->fluidNode) feet.push_back(static_cast<lid_t>(v));
+    std::vector<gid_t> feet;  // every membrane's nodes (each rank holds every membrane's surface)
+    for (Panel& p : panels_) {
+      const std::vector<gid_t>& nodes = p.module->fluidSurface()->fluidNode;
+      std::vector<lid_t> row(nodes.size());
+      for (std::size_t i = 0; i < nodes.size(); ++i) row[i] = static_cast<lid_t>(feet.size() + i);
+      p.footRow = toDevice(row, "mfsi::coupling::footRow");
+      feet.insert(feet.end(), nodes.begin(), nodes.end());
+    }
     columnFeet_ = static_cast<lid_t>(feet.size());
     columns_ = smoother_->setColumnFeet(feet);
     if (columns_ == 0)
@@ -846,11 +849,19 @@ void FsiCoupling::moveMesh(const InterfaceVector& x) {
     placeBodies(x);
     for (Panel& p : panels_) {
       copySegmentToDevice(x, p.offset, p.iterate);
-      if (p.mounted)
-        p.parents.displacement(exec_, p.module->solver().mesh().referencePoints(), p.iterate, p.iface.fluidNode,
-                               smoother_->displacement());
-      else
-        coupling::interfaceDisplacement(exec_, p.iface, p.iterate, smoother_->displacement());
+      auto place = [&](const coupling::MembraneInterface& iface, const Real3View& target) {
+        if (p.mounted)
+          p.parents.displacement(exec_, p.module->solver().mesh().referencePoints(), p.iterate, iface.fluidNode,
+                                 target);
+        else
+          coupling::interfaceDisplacement(exec_, iface, p.iterate, target);
+      };
+      place(p.iface, smoother_->displacement());  // the membrane's nodes on this rank's part
+      if (p.footRow.extent(0) > 0) {  // the columns' feet: every node, on every rank
+        coupling::MembraneInterface feet = p.iface;
+        feet.fluidNode = p.footRow;
+        place(feet, smoother_->columnFeet());
+      }
     }
   }
   {

@@ -35,12 +35,21 @@ void bottomBump(const MeshSmoother& s, const mfsi::HexMesh& mesh, double a) {
 
 /// The nodes whose reference point lies on the surface z = surface(x, y) (to 1e-12).
 template <class Surface>
-std::vector<lid_t> nodesOn(const mfsi::HexMesh& mesh, Surface surface) {
+std::vector<mfsi::gid_t> nodesOn(const mfsi::HexMesh& mesh, Surface surface) {
   auto hx = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), mesh.referencePoints());
-  std::vector<lid_t> nodes;
+  std::vector<mfsi::gid_t> nodes;
   for (lid_t i = 0; i < mesh.nNodes(); ++i)
     if (std::abs(hx(i, 2) - surface(hx(i, 0), hx(i, 1))) < 1e-12) nodes.push_back(i);
   return nodes;
+}
+
+/// The columns' feet take their nodes' displacement (a whole mesh: a node's global id is its index).
+void placeFeet(const MeshSmoother& s, const std::vector<mfsi::gid_t>& feet) {
+  auto d = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), s.displacement());
+  auto f = Kokkos::create_mirror_view(s.columnFeet());
+  for (std::size_t j = 0; j < feet.size(); ++j)
+    for (int c = 0; c < 3; ++c) f(j, c) = d(feet[j], c);
+  Kokkos::deep_copy(s.columnFeet(), f);
 }
 
 /// Thickness of the first cell row of a box of n cells graded gz along z.
@@ -145,13 +154,14 @@ TEST(MeshMotion, ColumnsCarryTheWallMotionLinearlyInArcLength) {
   o.columns = true;
   MeshSmoother s(mesh, o);
   auto hx = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), mesh.referencePoints());
-  std::vector<lid_t> feet;
+  std::vector<mfsi::gid_t> feet;
   for (lid_t i = 0; i < mesh.nNodes(); ++i)
     if (std::abs(hx(i, 2)) < 1e-12) feet.push_back(i);
   // Feet on the side walls have their one leaving edge on the wall (a boundary node): no column.
   EXPECT_EQ(s.setColumnFeet(feet), (n - 1) * (n - 1));
   const double a = 0.4;
   bottomBump(s, mesh, a);
+  placeFeet(s, feet);
   mfsi::ExecSpace exec;
   const auto rep = s.move(exec);
   exec.fence();
@@ -219,7 +229,8 @@ TEST(MeshMotion, ABafflesNodesCarryAColumnOnEachSide) {
   MeshSmootherOptions o;
   o.columns = true;
   MeshSmoother s(mesh, o);
-  EXPECT_EQ(s.setColumnFeet(nodesOn(mesh, [](double, double) { return 0.5; })), 2 * (n - 1) * (n - 1));
+  const auto feet = nodesOn(mesh, [](double, double) { return 0.5; });
+  EXPECT_EQ(s.setColumnFeet(feet), 2 * (n - 1) * (n - 1));
   auto hx = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), mesh.referencePoints());
   const double a = 0.2;
   auto hd = Kokkos::create_mirror_view(s.displacement());
@@ -229,6 +240,7 @@ TEST(MeshMotion, ABafflesNodesCarryAColumnOnEachSide) {
     if (std::abs(hx(i, 2) - 0.5) < 1e-12) hd(i, 2) = bump(i);
   }
   Kokkos::deep_copy(s.displacement(), hd);
+  placeFeet(s, feet);
   mfsi::ExecSpace exec;
   const auto rep = s.move(exec);
   exec.fence();
@@ -247,14 +259,15 @@ TEST(MeshMotion, ABafflesNodesCarryAColumnOnEachSide) {
 }
 
 TEST(MeshMotion, ColumnsStopWhereTheLineTurnsOrMeetsAnotherColumn) {
-  // Feet on two opposite walls: the columns from the bottom run up to the top wall (a boundary
-  // node), so those from the top find their lines claimed and are left to the Laplacian.
+  // Feet on two opposite walls: the columns from the bottom (the earlier feet) run up to the top
+  // wall (a boundary node), so those from the top, which run down through the same nodes, are left
+  // to the Laplacian.
   auto mesh = gradedBox(6, 1);
   MeshSmootherOptions o;
   o.columns = true;
   MeshSmoother s(mesh, o);
   auto hx = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), mesh.referencePoints());
-  std::vector<lid_t> bottom, both;
+  std::vector<mfsi::gid_t> bottom, both;
   for (lid_t i = 0; i < mesh.nNodes(); ++i) {
     if (std::abs(hx(i, 2)) < 1e-12) bottom.push_back(i);
     if (std::abs(hx(i, 2)) < 1e-12 || std::abs(hx(i, 2) - 1) < 1e-12) both.push_back(i);

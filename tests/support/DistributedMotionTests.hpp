@@ -7,7 +7,7 @@
 /// nodes' positions (gathered by global id) agree, the minimum scaled Jacobian is the same on every
 /// rank, and a repeat on the same ranks gives the same bits. Jacobi sweeps and CG (Jacobi- and
 /// AMG-preconditioned), under METIS and under a random partition (nearly every node a ghost
-/// somewhere).
+/// somewhere). With columns above the bottom, which cross the ranks, the same.
 #include "core/BlockMesh.hpp"
 #include "core/parallel/LocalMesh.hpp"
 #include "core/parallel/Partition.hpp"
@@ -37,22 +37,51 @@ struct MotionRun {
   std::map<gid_t, std::array<double, 3>> nodes;  ///< owned nodes' positions by global id
   double minScaledJacobian = 0;
   int iterations = 0;
+  lid_t columns = 0;  ///< with columns: how many (on all ranks)
 };
 
+/// The bottom's nodes of a whole mesh, by global id (its index), and their positions: with
+/// columns, the feet.
+struct BottomNodes {
+  std::vector<gid_t> ids;
+  std::vector<std::array<double, 3>> points;
+};
+
+inline BottomNodes bottomNodes(const HexMesh& whole) {
+  auto X = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), whole.referencePoints());
+  BottomNodes b;
+  for (lid_t i = 0; i < whole.nNodes(); ++i)
+    if (std::abs(X(i, 1)) < 1e-12) {
+      b.ids.push_back(i);
+      b.points.push_back({X(i, 0), X(i, 1), X(i, 2)});
+    }
+  return b;
+}
+
 /// Three moves of the bottom (u_y = a sin(pi x) sin(pi z), a = 0.05, 0.10, 0.15) on `mesh` (a
-/// rank's part when `domain` is distributed).
-inline MotionRun runMotion(HexMesh& mesh, const coupling::MeshSmootherOptions& o,
-                           const RankDomain& domain) {
+/// rank's part when `domain` is distributed); with o.columns, columns above the bottom's nodes.
+inline MotionRun runMotion(HexMesh& mesh, const coupling::MeshSmootherOptions& o, const RankDomain& domain,
+                           const BottomNodes& feet = {}) {
   auto smoother = domain.distributed() ? std::make_unique<coupling::MeshSmoother>(mesh, o, domain)
                                        : std::make_unique<coupling::MeshSmoother>(mesh, o);
   const double pi = 3.14159265358979323846;
+  auto bump = [pi](int move, double x, double z) { return 0.05 * move * std::sin(pi * x) * std::sin(pi * z); };
   auto X = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), mesh.referencePoints());
   MotionRun run;
+  run.columns = smoother->setColumnFeet(feet.ids);
   for (int move = 1; move <= 3; ++move) {
     auto d = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), smoother->displacement());
     for (lid_t i = 0; i < mesh.nNodes(); ++i)
-      if (std::abs(X(i, 1)) < 1e-12) d(i, 1) = 0.05 * move * std::sin(pi * X(i, 0)) * std::sin(pi * X(i, 2));
+      if (std::abs(X(i, 1)) < 1e-12) d(i, 1) = bump(move, X(i, 0), X(i, 2));
     Kokkos::deep_copy(smoother->displacement(), d);
+    if (run.columns > 0) {  // every foot's row, on every rank
+      auto f = Kokkos::create_mirror_view(smoother->columnFeet());
+      for (std::size_t j = 0; j < feet.ids.size(); ++j) {
+        f(j, 0) = f(j, 2) = 0;
+        f(j, 1) = bump(move, feet.points[j][0], feet.points[j][2]);
+      }
+      Kokkos::deep_copy(smoother->columnFeet(), f);
+    }
     const coupling::MotionReport r = smoother->move(ExecSpace());
     run.minScaledJacobian = r.minScaledJacobian;
     run.iterations += r.sweeps;
@@ -75,14 +104,16 @@ inline void checkDistributedMotion(const HexMeshInput& in, const std::vector<int
   MPI_Comm_rank(MPI_COMM_WORLD, &rank);
   HexMesh global = buildHexMesh(in);
   const HexMesh whole = buildHexMesh(in);  // the unmoved whole mesh, to cut the parts from
-  const MotionRun one = runMotion(global, o, RankDomain{});
+  const BottomNodes feet = o.columns ? bottomNodes(whole) : BottomNodes{};
+  const MotionRun one = runMotion(global, o, RankDomain{}, feet);
   ASSERT_GT(one.minScaledJacobian, 0.3);  // a real deformation, not a trivial one
   const LocalMeshPart part = localMeshPart(whole, cellRank, ranks, rank);
   const RankDomain domain = worldDomain(part);
   HexMesh local = buildHexMesh(part.input);
-  const MotionRun many = runMotion(local, o, domain);
+  const MotionRun many = runMotion(local, o, domain, feet);
   HexMesh again = buildHexMesh(part.input);
-  const MotionRun repeat = runMotion(again, o, domain);
+  const MotionRun repeat = runMotion(again, o, domain, feet);
+  EXPECT_EQ(many.columns, one.columns) << "rank " << rank;
   EXPECT_NEAR(many.minScaledJacobian, one.minScaledJacobian, tol * one.minScaledJacobian);
   double lo = many.minScaledJacobian, hi = many.minScaledJacobian;
   MPI_Allreduce(MPI_IN_PLACE, &lo, 1, MPI_DOUBLE, MPI_MIN, MPI_COMM_WORLD);
@@ -125,6 +156,24 @@ inline coupling::MeshSmootherOptions cgMotion(LaplacianPreconditioner pc) {
 }
 
 }  // namespace mfsi::test
+
+TEST(DistributedMotion, ColumnsCrossRanksOnMetisParts) {
+  // Columns from the bottom's interior nodes up to the top: the lines are handed from rank to
+  // rank, and every one of the n - 1 by n - 1 is found on the parts as on the whole mesh.
+  const mfsi::HexMeshInput in = mfsi::test::bulgingBox(8);
+  mfsi::coupling::MeshSmootherOptions o = mfsi::test::jacobiMotion();
+  o.columns = true;
+  mfsi::test::checkDistributedMotion(in, mfsi::test::metisParts(in, kRanks), o, 1e-14);
+  mfsi::HexMesh whole = mfsi::buildHexMesh(in);
+  EXPECT_EQ(mfsi::test::runMotion(whole, o, mfsi::RankDomain{}, mfsi::test::bottomNodes(whole)).columns, 7 * 7);
+}
+
+TEST(DistributedMotion, ColumnsCrossRanksOnARandomPartition) {
+  const mfsi::HexMeshInput in = mfsi::test::bulgingBox(6);
+  mfsi::coupling::MeshSmootherOptions o = mfsi::test::cgMotion(mfsi::LaplacianPreconditioner::Amg);
+  o.columns = true;
+  mfsi::test::checkDistributedMotion(in, mfsi::test::randomPartition(in.cells.size(), kRanks), o, 1e-11);
+}
 
 TEST(DistributedMotion, JacobiSweepsOnMetisParts) {
   const mfsi::HexMeshInput in = mfsi::test::bulgingBox(8);
