@@ -363,6 +363,81 @@ struct ByteCount {
 };
 
 /// Coarsest-level gathers made by every DistributedAmg of this process (DistributedAmg::coarseGathers).
+/// A communicator of a few ranks, freed with its holder.
+class GroupComm {
+ public:
+  GroupComm() = default;
+  explicit GroupComm(MPI_Comm c) : comm_(c) {}
+  GroupComm(GroupComm&& o) noexcept : comm_(o.comm_) { o.comm_ = MPI_COMM_NULL; }
+  GroupComm& operator=(GroupComm&& o) noexcept {
+    std::swap(comm_, o.comm_);
+    return *this;
+  }
+  GroupComm(const GroupComm&) = delete;
+  GroupComm& operator=(const GroupComm&) = delete;
+  ~GroupComm() {
+    int finalized = 1;
+    MPI_Finalized(&finalized);
+    if (comm_ != MPI_COMM_NULL && !finalized) MPI_Comm_free(&comm_);
+  }
+  MPI_Comm get() const { return comm_; }
+
+ private:
+  MPI_Comm comm_ = MPI_COMM_NULL;
+};
+
+template <class S>
+MPI_Datatype mpiScalar() {
+  return std::is_same<S, float>::value ? MPI_FLOAT : MPI_DOUBLE;
+}
+
+/// The first `owned` entries of `from` on every member of `group`, one after the other in member
+/// order, into the first entries of `to` on the group's first member (MPI_Gatherv; `counts` and
+/// `displs` are read there). Staged through host mirrors (no copy on host memory).
+template <class S>
+void gatherToFirst(const ExecSpace& exec, MPI_Comm group, const std::vector<int>& counts,
+                   const std::vector<int>& displs, lid_t owned, const SView<S>& from, const SView<S>& to) {
+  const auto src = Kokkos::subview(from, std::make_pair(0, owned));
+  const auto dst = Kokkos::subview(to, std::make_pair(0, displs.empty() ? 0 : displs.back()));
+  auto hs = Kokkos::create_mirror_view(src);
+  auto hd = Kokkos::create_mirror_view(dst);
+  exec.fence();
+  Kokkos::deep_copy(hs, src);
+  MPI_Gatherv(hs.data(), owned, mpiScalar<S>(), hd.data(), counts.data(), displs.data(), mpiScalar<S>(), 0, group);
+  Kokkos::deep_copy(dst, hd);
+}
+
+/// The reverse of gatherToFirst: each member's rows of `from` (on the first member) into the first
+/// `owned` entries of its `to` (MPI_Scatterv).
+template <class S>
+void scatterFromFirst(const ExecSpace& exec, MPI_Comm group, const std::vector<int>& counts,
+                      const std::vector<int>& displs, lid_t owned, const SView<S>& from, const SView<S>& to) {
+  const auto src = Kokkos::subview(from, std::make_pair(0, displs.empty() ? 0 : displs.back()));
+  const auto dst = Kokkos::subview(to, std::make_pair(0, owned));
+  auto hs = Kokkos::create_mirror_view(src);
+  auto hd = Kokkos::create_mirror_view(dst);
+  exec.fence();
+  Kokkos::deep_copy(hs, src);
+  MPI_Scatterv(hs.data(), counts.data(), displs.data(), mpiScalar<S>(), hd.data(), owned, mpiScalar<S>(), 0, group);
+  Kokkos::deep_copy(dst, hd);
+}
+
+/// MPI_Gatherv onto the group's first member of `mine` (any trivially copyable T, sent as bytes);
+/// the members' parts one after the other there, empty elsewhere.
+template <class T>
+std::vector<T> gatherOnFirst(MPI_Comm group, const std::vector<T>& mine) {
+  int size = 1, rank = 0;
+  MPI_Comm_size(group, &size);
+  MPI_Comm_rank(group, &rank);
+  int bytes = static_cast<int>(mine.size() * sizeof(T));
+  std::vector<int> counts(static_cast<std::size_t>(size)), displs(static_cast<std::size_t>(size) + 1, 0);
+  MPI_Gather(&bytes, 1, MPI_INT, counts.data(), 1, MPI_INT, 0, group);
+  for (int r = 0; r < size; ++r) displs[r + 1] = displs[r] + counts[r];
+  std::vector<T> all(rank == 0 ? static_cast<std::size_t>(displs[size]) / sizeof(T) : 0);
+  MPI_Gatherv(mine.data(), bytes, MPI_BYTE, all.data(), counts.data(), displs.data(), MPI_BYTE, 0, group);
+  return all;
+}
+
 std::int64_t gCoarseGathers = 0;
 
 }  // namespace
@@ -379,16 +454,30 @@ struct DistributedAmg::Impl {
     RealView invDiag, x, b, r, d;
     double lambdaMax = 1;
     LatticeRows lattice;  ///< this level's lattice (owned rows), when it is aggregated into cubes
+    /// A level moved onto fewer ranks (agglomerateRows): its rows as the finer level's R and P see
+    /// them (the layout it was built in) and how they travel to and from the ranks that hold it.
+    struct Arrival {
+      bool moved = false;
+      GroupComm group;                  ///< the ranks whose rows one of them gathers (null: none)
+      std::vector<int> counts, displs;  ///< rows per group member, on the group's first member
+      lid_t owned = 0, local = 0;       ///< this rank's rows, and rows + ghosts, in that layout
+      std::unique_ptr<Halo> halo;       ///< that layout's halo (the finer level's P's ghost columns)
+    } arrival;
   };
   /// A level in the cycle's precision S (S = double: the level's own matrices and vectors).
   template <class S>
   struct CycleLevel {
     CycleMat<S> A, P, R;
     SView<S> invDiag, x, b, r, d;
+    SView<S> bArrive, xArrive;  ///< a moved level's b and x in the layout it was built in
   };
 
   MPI_Comm comm = MPI_COMM_NULL;  ///< null on one rank
   int ranks = 1, me = 0;
+  /// Set-up: the ranks that may hold rows of the level being built are the multiples of stride
+  /// (1 until a level moves onto fewer ranks).
+  int stride = 1;
+  bool coarseOnOneRank = false;  ///< the coarsest level is on one rank: its solve gathers nothing
   DistributedAmgOptions opt;
   HaloPlan finePlan;
   std::vector<gid_t> fineIds;
@@ -443,6 +532,7 @@ struct DistributedAmg::Impl {
     li.nonzeros = globalCount(L.hA.ptr.back());
     li.ownedRows = L.hA.nRows;
     li.ghosts = L.hA.nCols - L.hA.nRows;
+    li.ranks = static_cast<int>(globalCount(L.hA.nRows > 0 ? 1 : 0));
     info.push_back(li);
   }
 
@@ -584,9 +674,88 @@ struct DistributedAmg::Impl {
     for (std::size_t g = 0; g < ghosts.size(); ++g) C.gid[nAgg + g] = ghosts[g];
     C.plan = planFromGhosts(comm, first, nAgg, ghosts, owner);
     C.lattice = std::move(coarseLattice);
-    levels.push_back(std::move(C));
+    const int holding = (ranks + stride - 1) / stride;  // ranks that may hold rows of C
+    if (opt.agglomerateRows > 0 && holding > 1 && coarseRows / holding < opt.agglomerateRows)
+      levels.push_back(moveOntoFewerRanks(std::move(C), start, coarseRows, holding));
+    else
+      levels.push_back(std::move(C));
     finishLevel(exec, levels.back(), l + 1);
     return true;
+  }
+
+  /// Level C (rows: the aggregates of each rank, numbered by `start`) moved onto fewer ranks, about
+  /// agglomerateRows rows each: the rows of each run of consecutive holding ranks onto the first of
+  /// them, so every rank's ids stay one range. Collective.
+  Level moveOntoFewerRanks(Level&& C, const std::vector<gid_t>& start, std::int64_t rows, int holding) {
+    const int keep = static_cast<int>(std::max<std::int64_t>(1, rows / opt.agglomerateRows));
+    const int newStride = stride * ((holding + keep - 1) / keep);
+    const int first = (me / newStride) * newStride;  // the rank that takes this rank's rows
+    const auto ownerOf = [&](gid_t id) {
+      const int r = static_cast<int>(std::upper_bound(start.begin(), start.end(), id) - start.begin()) - 1;
+      return (r / newStride) * newStride;
+    };
+    Level M;
+    M.arrival.moved = true;
+    M.arrival.owned = C.hA.nRows;
+    M.arrival.local = C.hA.nCols;
+    M.arrival.halo = std::make_unique<Halo>(comm, C.plan);
+    M.lattice.extent = C.lattice.extent;
+    MPI_Comm group = MPI_COMM_NULL;
+    MPI_Comm_split(comm, me % stride == 0 ? first : MPI_UNDEFINED, me, &group);
+    M.arrival.group = GroupComm(group);
+    std::vector<gid_t> ghosts;
+    std::vector<int> ghostOwner;
+    gid_t newFirst = 0;
+    if (group != MPI_COMM_NULL) {
+      // Each member's rows (length, global columns, values) and lattice cells, onto the first.
+      const lid_t n = C.hA.nRows;
+      std::vector<int> len(n);
+      std::vector<gid_t> cols;
+      for (lid_t i = 0; i < n; ++i) len[i] = C.hA.ptr[i + 1] - C.hA.ptr[i];
+      for (lid_t c : C.hA.col) cols.push_back(C.gid[c]);
+      const std::vector<int> allLen = gatherOnFirst(group, len);
+      const std::vector<gid_t> allCols = gatherOnFirst(group, cols);
+      const std::vector<double> allVals = gatherOnFirst(group, C.hA.val);
+      const std::vector<std::array<std::int64_t, 3>> allAt = gatherOnFirst(group, C.lattice.at);
+      const std::vector<int> counts = gatherOnFirst(group, std::vector<int>{n});
+      if (me == first) {
+        M.arrival.counts = counts;
+        M.arrival.displs.assign(1, 0);
+        for (int c : counts) M.arrival.displs.push_back(M.arrival.displs.back() + c);
+        newFirst = start[first];
+        const lid_t total = static_cast<lid_t>(allLen.size());
+        const gid_t newLast = newFirst + total;
+        for (gid_t c : allCols)
+          if (c < newFirst || c >= newLast) ghosts.push_back(c);
+        std::sort(ghosts.begin(), ghosts.end());
+        ghosts.erase(std::unique(ghosts.begin(), ghosts.end()), ghosts.end());
+        for (gid_t g : ghosts) ghostOwner.push_back(ownerOf(g));
+        auto localOf = [&](gid_t c) -> lid_t {
+          if (c >= newFirst && c < newLast) return static_cast<lid_t>(c - newFirst);
+          return total + static_cast<lid_t>(std::lower_bound(ghosts.begin(), ghosts.end(), c) - ghosts.begin());
+        };
+        M.hA.nRows = total;
+        M.hA.nCols = total + static_cast<lid_t>(ghosts.size());
+        std::size_t p = 0;
+        for (lid_t i = 0; i < total; ++i) {
+          std::vector<std::pair<lid_t, double>> row;
+          for (int e = 0; e < allLen[i]; ++e, ++p) row.emplace_back(localOf(allCols[p]), allVals[p]);
+          std::sort(row.begin(), row.end());
+          for (const auto& [c, v] : row) {
+            M.hA.col.push_back(c);
+            M.hA.val.push_back(v);
+          }
+          M.hA.ptr.push_back(static_cast<lid_t>(M.hA.col.size()));
+        }
+        M.gid.resize(static_cast<std::size_t>(M.hA.nCols));
+        for (lid_t i = 0; i < total; ++i) M.gid[i] = newFirst + i;
+        for (std::size_t g = 0; g < ghosts.size(); ++g) M.gid[total + g] = ghosts[g];
+        if (M.lattice.valid()) M.lattice.at = allAt;
+      }
+    }
+    M.plan = planFromGhosts(comm, newFirst, M.hA.nRows, ghosts, ghostOwner);
+    stride = newStride;
+    return M;
   }
 
   /// Gather the last level onto every rank and invert it (pseudo-inverse: a singular Neumann
@@ -651,6 +820,11 @@ struct DistributedAmg::Impl {
     }
     coarseAll = RealView("mfsi::kernels::damg::coarseAll", total);
     coarseAmg.reset();
+    coarseOnOneRank = std::count_if(coarseCounts.begin(), coarseCounts.end(), [](int c) { return c > 0; }) <= 1;
+    if (coarseOnOneRank && n == 0) {  // another rank holds the whole level
+      coarseInv = Kokkos::View<double**, MemSpace>("mfsi::kernels::damg::coarseInverse", 0, total);
+      return;
+    }
     if (ranks > 1 && total > opt.denseCoarseRows) {
       gatheredAmg(exec, g, allRows);
       return;
@@ -689,7 +863,8 @@ struct DistributedAmg::Impl {
 
   void coarseSolve(const ExecSpace& exec, Level& L) {
     const lid_t n = L.hA.nRows;
-    if (ranks == 1) {
+    if (coarseOnOneRank && n == 0) return;  // the rank that holds the level solves it alone
+    if (ranks == 1 || coarseOnOneRank) {
       Kokkos::deep_copy(exec, Kokkos::subview(coarseAll, std::make_pair(0, n)), Kokkos::subview(L.b, std::make_pair(0, n)));
     } else {
       auto hb = Kokkos::create_mirror_view_and_copy(HostSpace(), Kokkos::subview(L.b, std::make_pair(0, n)));
@@ -740,6 +915,8 @@ struct DistributedAmg::Impl {
         C.P = cycleMat<S>(exec, L.P);
         C.R = cycleMat<S>(exec, L.R);
       }
+      if (L.arrival.moved)
+        for (SView<S>* v : {&C.bArrive, &C.xArrive}) *v = SView<S>(label + "::arrival", L.arrival.local);
       cycle.push_back(std::move(C));
     }
   }
@@ -788,7 +965,7 @@ struct DistributedAmg::Impl {
   static void count(ByteCount& c, const std::vector<CycleLevel<S>>& cycle) {
     for (const CycleLevel<S>& C : cycle) {
       for (const CycleMat<S>* M : {&C.A, &C.P, &C.R}) c.csr(*M);
-      for (const SView<S>* v : {&C.invDiag, &C.x, &C.b, &C.r, &C.d}) c.view(*v);
+      for (const SView<S>* v : {&C.invDiag, &C.x, &C.b, &C.r, &C.d, &C.bArrive, &C.xArrive}) c.view(*v);
     }
   }
 
@@ -836,10 +1013,22 @@ struct DistributedAmg::Impl {
     fromProduct<S>(exec, n, C.b, C.r);
     L.halo->exchange(exec, C.r);
     CycleLevel<S>& N = cyc[l + 1];
-    spmv<S>(exec, 1, C.R, C.r, 0, N.b);
-    cycle(exec, cyc, l + 1);
-    levels[l + 1].halo->exchange(exec, N.x);
-    spmv<S>(exec, 1, C.P, N.x, 1, C.x);
+    const typename Level::Arrival& a = levels[l + 1].arrival;
+    if (!a.moved) {
+      spmv<S>(exec, 1, C.R, C.r, 0, N.b);
+      cycle(exec, cyc, l + 1);
+      levels[l + 1].halo->exchange(exec, N.x);
+      spmv<S>(exec, 1, C.P, N.x, 1, C.x);
+    } else {  // the next level lives on fewer ranks: its b goes there, its x comes back
+      spmv<S>(exec, 1, C.R, C.r, 0, N.bArrive);
+      if (a.group.get() != MPI_COMM_NULL)
+        gatherToFirst<S>(exec, a.group.get(), a.counts, a.displs, a.owned, N.bArrive, N.b);
+      cycle(exec, cyc, l + 1);
+      if (a.group.get() != MPI_COMM_NULL)
+        scatterFromFirst<S>(exec, a.group.get(), a.counts, a.displs, a.owned, N.x, N.xArrive);
+      a.halo->exchange(exec, N.xArrive);
+      spmv<S>(exec, 1, C.P, N.xArrive, 1, C.x);
+    }
     chebyshev(exec, L, C, false);
   }
 };
@@ -872,6 +1061,7 @@ void DistributedAmg::setup(const ExecSpace& exec, const CsrMatrix& A) {
                                    << " owned and " << m.finePlan.nLocal << " local entries");
   m.levels.clear();
   m.info.clear();
+  m.stride = 1;
   Impl::Level L0;
   L0.hA = hostCopy(A);
   L0.gid = m.fineIds;

@@ -16,10 +16,13 @@
 ///    the coarse operators keep the coupling between ranks: A_c = R (A P) with R = P^T, rows of P
 ///    and of A P sent to the ranks that hold them as ghosts (core/parallel/RowExchange);
 ///  - each level has its own halo (the coarse ghosts a rank's rows and prolongator touch);
+///  - a coarse level with fewer than `agglomerateRows` rows per rank moves onto fewer ranks (each
+///    run of consecutive ranks gathers onto its first; the cycle gathers its right-hand side there
+///    and scatters its correction back), so small levels are not spread thin over many ranks;
 ///  - once a level has at most `coarseSize` rows over all ranks (or cannot coarsen further) it is
-///    gathered onto every rank and solved there, the same on every rank (so deterministic): by a
-///    dense pseudo-inverse up to `denseCoarseRows` rows, above that by one V-cycle of a
-///    one-process DistributedAmg of the gathered matrix;
+///    solved directly: by the one rank that holds it, or else gathered onto every rank and solved
+///    there, the same on every rank (so deterministic); by a dense pseudo-inverse up to
+///    `denseCoarseRows` rows, above that by one V-cycle of a one-process DistributedAmg of it;
 ///  - symmetric V-cycle with fourth-kind Chebyshev smoothing in D^{-1} A (lambda_max from power
 ///    iterations, boosted by 1.1), every product after a halo exchange; every sum in a fixed order;
 ///    in float by default (`mixedPrecision`), set-up in double.
@@ -49,6 +52,12 @@ struct DistributedAmgOptions {
   /// one-process AMG built on the gathered matrix, the same on every rank, instead of a dense
   /// pseudo-inverse whose set-up grows with its cube.
   std::int64_t denseCoarseRows = 500;
+  /// A coarse level with fewer rows than this per rank that may hold rows moves onto fewer ranks,
+  /// about this many rows each (the rows of consecutive ranks onto the first of them): the levels
+  /// below it are built and cycled on those ranks only, so the many-rank exchanges of small levels
+  /// become a gather and a scatter within each group, and a coarsest level on one rank is solved
+  /// there without a gather. 0: never (every rank keeps its rows down to the coarsest level).
+  std::int64_t agglomerateRows = 800;
   int maxLevels = 16;
   /// Lattice-aligned cubes where the fine matrix is a structured lattice (false: greedy always).
   bool latticeAggregation = true;
@@ -65,6 +74,7 @@ struct DistributedAmgLevelInfo {
   lid_t ownedRows = 0;
   lid_t ghosts = 0;
   bool lattice = false;  ///< aggregated into lattice cubes (false: greedily, or the coarsest level)
+  int ranks = 0;         ///< ranks that hold rows of the level
 };
 
 class DistributedAmg final : public Preconditioner {

@@ -2,9 +2,9 @@
 // mpirun: iterations, set-up and solve times, the levels, halo traffic. perf/distributed_amg.sh
 // runs it on 1, 2 and 4 ranks and writes perf/results/distributed_amg.txt.
 //
-//   mpirun -np 4 build/perf/perf_distributed_amg 64 [neumann|dirichlet] [greedy] [double]
+//   mpirun -np 4 build/perf/perf_distributed_amg 64 [neumann|dirichlet] [greedy] [double] [spread]
 // (for comparison: "greedy" aggregates greedily even where the box is a lattice, "double" runs the
-// V-cycle in double instead of float)
+// V-cycle in double instead of float, "spread" keeps every level on every rank: agglomerateRows 0)
 #include "core/BlockMesh.hpp"
 #include "core/parallel/Halo.hpp"
 #include "core/parallel/LocalMesh.hpp"
@@ -65,12 +65,13 @@ int main(int argc, char** argv) {
     MPI_Comm_size(MPI_COMM_WORLD, &ranks);
     MPI_Comm_rank(MPI_COMM_WORLD, &rank);
     const int n = argc > 1 ? std::atoi(argv[1]) : 32;
-    bool neumann = false, greedy = false, inDouble = false;
+    bool neumann = false, greedy = false, inDouble = false, spread = false;
     for (int a = 2; a < argc; ++a) {
       const std::string w = argv[a];
       neumann = neumann || w == "neumann";
       greedy = greedy || w == "greedy";
       inDouble = inDouble || w == "double";
+      spread = spread || w == "spread";
     }
     BlockMeshSpec spec = boxSpec({0, 0, 0}, {1, 1, 1}, {n, n, n});
     spec.blocks[0].patches[0] = "xmin";
@@ -97,6 +98,7 @@ int main(int argc, char** argv) {
     DistributedAmgOptions aopt;
     aopt.latticeAggregation = !greedy;
     aopt.mixedPrecision = !inDouble;
+    if (spread) aopt.agglomerateRows = 0;
     DistributedAmg amg(MPI_COMM_WORLD, lp.cells, std::vector<mfsi::gid_t>(gid.data(), gid.data() + gid.extent(0)),
                        aopt);
     amg.setup(exec, A);
@@ -125,7 +127,7 @@ int main(int argc, char** argv) {
                   n, neumann ? "neumann" : "dirichlet", amg.levels().front().lattice ? "lattice" : "greedy", inDouble ? "double" : "float", ranks, exec.concurrency(),
                   static_cast<long long>(part.edgeCut), r.iterations, toString(r.status), tSetup, tSolve,
                   1e3 * tSolve / std::max(1, r.iterations));
-      for (const auto& l : amg.levels()) std::printf(" %lld", static_cast<long long>(l.rows));
+      for (const auto& l : amg.levels()) std::printf(" %lld@%d", static_cast<long long>(l.rows), l.ranks);
       std::printf(" | fine halo: %d messages, %lld bytes per exchange (all ranks) | hierarchy %.1f MB, %.0f bytes per "
                   "fine row (all ranks)\n",
                   allMessages, allBytes, 1e-6 * static_cast<double>(allHeld),

@@ -18,15 +18,19 @@ Assumed (flags):
   k      neighbours of a rank (14, METIS in 3D; P - 1 when fewer);
   cut    faces a rank cuts: 1.2 * 6 * n^(2/3) for n cells (a cube's six faces; METIS cut 1.2x the
          plane in the 2-rank runs);
-  coarse rows gathered per V-cycle: max(300, 4 P) as built (decoupled aggregation leaves 2-8 rows
-         per rank), solved on every rank by the gathered level's one-process AMG at c_row s per row
-         and V-cycle (6.7e-8: the AMG-CG iteration on the 64^3 Laplacian, perf/distributed_amg.sh);
-         the second table: coarse levels moved onto fewer ranks as they shrink (not built), so the
-         gathered level stays at 300 rows, for log8(P) more levels of exchanges per V-cycle;
+  coarse levels, as built (the first table): a level with fewer than 800 rows per rank moves onto
+         fewer ranks (agglomerateRows), so coarsening goes on to 300 rows on one rank, which solves
+         it at c_row s per row and V-cycle (6.7e-8: the AMG-CG iteration on the 64^3 Laplacian,
+         perf/distributed_amg.sh), for log8(P) more levels of exchanges per V-cycle and, per
+         V-cycle, a gather and a scatter within each group of ranks that merges (together about
+         2 ceil(log2 P) tree steps); the second table (agglomerateRows 0): the coarsest level stays
+         on every rank at max(300, 4 P) rows (decoupled aggregation leaves 2-8 rows per rank) and
+         each V-cycle gathers it onto every rank, which all solve it by its one-process AMG. G is
+         the V-cycles per step (measured with the coarsest gathered, one gather per V-cycle);
   share  of the step that grows with the pressure iterations (0.5).
 Per rank and step: T = n c f + E f (alpha + (k - 1) o) + b f cut / beta
                       + R (alpha ceil(log2 P) + 16 P / beta)            (sums: an allgather of ~2 doubles)
-                      + G f (alpha ceil(log2 P) + 8 n_c / beta + n_c c_row)
+                      + G f (m alpha ceil(log2 P) + 8 n_c / beta + n_c c_row)   (m: 2 moved, 1 gathered)
 with f = its(N) / its(measured) and efficiency = n c f / T (perfect scaling of the measured
 per-core rate = 100 %). Latency that the exchanges could hide behind interior work is not hidden:
 the fluid does not overlap yet.
@@ -101,8 +105,10 @@ def main():
     print("Assumed: alpha = %g s, o = %g s, beta = %g B/s per rank, k = %d neighbours, share = %.2f\n"
           % (a.alpha, a.o, a.beta, a.k, a.share))
     for built in (True, False):
-        print("\n%s\n" % ("As built: the coarsest level (about 4 rows per rank) gathered onto every rank:" if built else
-                           "If coarse levels moved onto fewer ranks as they shrink (not built):"))
+        print("\n%s\n" % ("As built: coarse levels move onto fewer ranks as they shrink, the coarsest solved on one "
+                           "rank:" if built else
+                           "Without moving them (agglomerateRows: 0): the coarsest level (about 4 rows per rank) "
+                           "gathered onto every rank:"))
         print("| cells | ranks | cells per rank | pressure its/step | compute | exchanges (latency) | halo bytes | "
               "reductions | coarse gathers | modelled s/step | efficiency |")
         print("|---|---|---|---|---|---|---|---|---|---|---|")
@@ -115,13 +121,13 @@ def main():
                 k = min(a.k, P - 1)
                 lg = math.ceil(math.log2(P))
                 comp = n * c * f
-                extra = 0 if built else 6 * G * math.log(P, 8)  # ~6 exchanges per level and V-cycle
+                extra = 6 * G * math.log(P, 8) if built else 0  # ~6 exchanges per level and V-cycle
                 exch = (E * fc + extra * fc) * (a.alpha + (k - 1) * a.o)
                 cut = 1.2 * 6 * n ** (2.0 / 3.0)
                 byt = b * fc * cut / a.beta
                 red = R * fc * (a.alpha * lg + 16 * P / a.beta)
-                nc = max(300, 4 * P) if built else 300
-                gat = G * fc * (a.alpha * lg + 8 * nc / a.beta + nc * c_row)
+                nc = 300 if built else max(300, 4 * P)
+                gat = G * fc * ((2 if built else 1) * a.alpha * lg + 8 * nc / a.beta + nc * c_row)
                 total = comp + exch + byt + red + gat
                 ms = lambda t: "%.2f ms" % (1e3 * t)
                 print("| %.0e | %d | %.0f | %.1f | %s | %s | %s | %s | %s | %s | **%.0f %%** |" % (

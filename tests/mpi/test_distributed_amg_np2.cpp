@@ -97,3 +97,11 @@ TEST(DistributedAmg, TheFloatCycleTakesTheIterationsOfTheDoubleOne) {
   EXPECT_LT(static_cast<double>(withFloat.bytes), 0.7 * static_cast<double>(withDouble.bytes));
   EXPECT_GT(static_cast<double>(withFloat.bytes), 0.5 * static_cast<double>(withDouble.bytes));
 }
+
+TEST(DistributedAmg, CoarseLevelsMoveOntoFewerRanksAsTheyShrink) {
+  // 24^3 cells: 13,824 rows, about 1,900 on the second level, 80 on the third.
+  const HexMeshInput in = box({24, 24, 24});
+  PartitionOptions opt;
+  opt.parts = 2;
+  test::checkCoarseLevelsMoveOntoFewerRanks(in, partitionCells(in, opt).cellRank, {2, 2, 1});
+}

@@ -35,3 +35,11 @@ TEST(DistributedAmg, ALargeGatheredCoarseLevelIsSolvedByItsOwnAmg) {
   opt.parts = 4;
   test::checkGatheredCoarseAmg(in, partitionCells(in, opt).cellRank);
 }
+
+TEST(DistributedAmg, CoarseLevelsMoveOntoFewerRanksAsTheyShrink) {
+  // 24^3 cells: 13,824 rows, about 1,900 on the second level, 80 on the third.
+  const HexMeshInput in = box({24, 24, 24});
+  PartitionOptions opt;
+  opt.parts = 4;
+  test::checkCoarseLevelsMoveOntoFewerRanks(in, partitionCells(in, opt).cellRank, {4, 2, 1});
+}

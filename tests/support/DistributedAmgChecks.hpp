@@ -7,6 +7,9 @@
 #include "kernels/DistributedAmg.hpp"
 #include "support/DistributedLaplacian.hpp"
 
+#include <cstdint>
+#include <limits>
+
 namespace mfsi::test {
 
 struct AmgSolve {
@@ -78,9 +81,9 @@ inline AmgComparison checkDistributedAmg(const HexMeshInput& in, const std::vect
   MPI_Allreduce(&its, &maxIts, 1, MPI_INT, MPI_MAX, MPI_COMM_WORLD);
   EXPECT_EQ(minIts, maxIts);
   if (rank == 0) {
-    std::printf("AMG-CG to 1e-12: %d iterations on one process, %d on %d ranks; levels (rows):", one.solve.iterations,
-                dist.solve.iterations, ranks);
-    for (const auto& l : dist.levels) std::printf(" %lld", static_cast<long long>(l.rows));
+    std::printf("AMG-CG to 1e-12: %d iterations on one process, %d on %d ranks; levels (rows on ranks):",
+                one.solve.iterations, dist.solve.iterations, ranks);
+    for (const auto& l : dist.levels) std::printf(" %lld on %d", static_cast<long long>(l.rows), l.ranks);
     std::printf("\n");
   }
   return {one.solve.iterations, dist.solve.iterations, dist.levels, dist.bytes};
@@ -88,13 +91,41 @@ inline AmgComparison checkDistributedAmg(const HexMeshInput& in, const std::vect
 
 /// The coarsest level gathered early (at most 5,000 rows) and solved by a one-process AMG of the
 /// gathered matrix (above 100 rows), as on many ranks: the answer of the one-process dense-coarse
-/// hierarchy, within two iterations of it.
+/// hierarchy, within two iterations of it; and the same level moved onto one rank that solves it
+/// alone.
 inline void checkGatheredCoarseAmg(const HexMeshInput& in, const std::vector<int>& cellRank) {
   DistributedAmgOptions o;
   o.coarseSize = 5000;
   o.denseCoarseRows = 100;
   const AmgComparison c = checkDistributedAmg(in, cellRank, o);
   EXPECT_LE(c.many, c.one + 2);
+  // The same level moved whole onto one rank, which solves it by its AMG alone.
+  o.agglomerateRows = std::numeric_limits<std::int64_t>::max() / 64;
+  const AmgComparison one = checkDistributedAmg(in, cellRank, o);
+  EXPECT_LE(one.many, one.one + 2);
+  EXPECT_EQ(one.levels.back().ranks, 1);
+}
+
+/// Coarse levels moved onto fewer ranks as they shrink (agglomerateRows 500): the one-process
+/// answer within two iterations, each level on `expectedRanks` ranks, and a coarsest level on one
+/// rank solved where it is, with no gather in any cycle. Without moving (agglomerateRows 0) every
+/// level stays on every rank and each cycle gathers the coarsest.
+inline void checkCoarseLevelsMoveOntoFewerRanks(const HexMeshInput& in, const std::vector<int>& cellRank,
+                                                const std::vector<int>& expectedRanks) {
+  int ranks = 1;
+  MPI_Comm_size(MPI_COMM_WORLD, &ranks);
+  DistributedAmgOptions o;
+  o.agglomerateRows = 500;
+  const std::int64_t before = DistributedAmg::coarseGathers();
+  const AmgComparison moved = checkDistributedAmg(in, cellRank, o);
+  EXPECT_EQ(DistributedAmg::coarseGathers(), before) << "the coarsest level is on one rank: nothing to gather";
+  EXPECT_LE(moved.many, moved.one + 2);
+  ASSERT_EQ(moved.levels.size(), expectedRanks.size());
+  for (std::size_t l = 0; l < expectedRanks.size(); ++l) EXPECT_EQ(moved.levels[l].ranks, expectedRanks[l]) << l;
+  o.agglomerateRows = 0;
+  const AmgComparison spread = checkDistributedAmg(in, cellRank, o);
+  for (const auto& l : spread.levels) EXPECT_EQ(l.ranks, ranks);
+  EXPECT_GE(DistributedAmg::coarseGathers(), before + spread.many);
 }
 
 }  // namespace mfsi::test
