@@ -37,6 +37,7 @@ class ColumnSearch {
       if (it != local_.end()) isFoot_[it->second] = 1;
     }
     status_.assign(2 * feet_.size(), kUntraced);
+    handedOn_.assign(2 * feet_.size(), 0);
     length_.assign(2 * feet_.size(), 0.0);
     ranks_ = 1;
     if (g_.comm != MPI_COMM_NULL) MPI_Comm_size(g_.comm, &ranks_);
@@ -115,6 +116,7 @@ class ColumnSearch {
         const double packed[kTraceWidth] = {double(t.line), double(g_.gid[t.prev]), double(g_.gid[cur]), t.dir[0],
                                             t.dir[1], t.dir[2], t.s, double(t.count)};
         out.insert(out.end(), packed, packed + kTraceWidth);
+        handedOn_[static_cast<std::size_t>(t.line)] = 1;
         return;
       }
       visits_.push_back({t.line, cur, t.s});
@@ -198,6 +200,7 @@ class ColumnSearch {
     if (g_.comm != MPI_COMM_NULL) {
       MPI_Allreduce(MPI_IN_PLACE, status_.data(), static_cast<int>(status_.size()), MPI_INT, MPI_MAX, g_.comm);
       MPI_Allreduce(MPI_IN_PLACE, length_.data(), static_cast<int>(length_.size()), MPI_DOUBLE, MPI_SUM, g_.comm);
+      MPI_Allreduce(MPI_IN_PLACE, handedOn_.data(), static_cast<int>(handedOn_.size()), MPI_INT, MPI_MAX, g_.comm);
     }
     // The pairs of traced lines through one node: a node is visited on the rank that owns it.
     std::vector<std::pair<lid_t, long long>> byNode;
@@ -251,6 +254,8 @@ class ColumnSearch {
       set.weight.push_back(1 - v.s / length_[line]);
     }
     set.count = static_cast<lid_t>(std::count(status_.begin(), status_.end(), kKept));
+    for (std::size_t line = 0; line < status_.size(); ++line)
+      set.acrossRanks += status_[line] == kKept && handedOn_[line] != 0 ? 1 : 0;
     return set;
   }
 
@@ -266,6 +271,7 @@ class ColumnSearch {
   std::vector<char> isFoot_;
   std::vector<int> status_;       ///< LineStatus per line (2 foot + side)
   std::vector<double> length_;    ///< a kept line's length, to its far end
+  std::vector<int> handedOn_;     ///< per line: 1 once it went from one rank to another
   std::vector<Visit> visits_;     ///< the owned nodes the lines passed, in order
   std::vector<std::vector<double>> outgoing_;  ///< lines in flight, per rank they go to
   int ranks_ = 1;

@@ -37,6 +37,7 @@ struct ColumnSet {
   std::vector<lid_t> foot;     ///< its foot's index in the feet list
   std::vector<double> weight;  ///< 1 - (arc length from the foot) / (the column's length)
   lid_t count = 0;             ///< columns on all ranks
+  lid_t acrossRanks = 0;       ///< of those, the ones whose nodes more than one rank owns
 };
 
 /// \brief The columns above `feet` (global node ids, the same list on every rank). A foot with one

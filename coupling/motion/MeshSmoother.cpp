@@ -276,6 +276,7 @@ lid_t MeshSmoother::setColumnFeet(const std::vector<gid_t>& feet) {
   columns_.foot = toDevice(hFoot, "mfsi::coupling::motion::columnFoot");
   columns_.weight = toDevice(hWeight, "mfsi::coupling::motion::columnWeight");
   columns_.feet = Real3View("mfsi::coupling::motion::columnFeet", feet.size());
+  columns_.acrossRanks = set.acrossRanks;
   Kokkos::deep_copy(fixed_, fixed);
   cg_ = LaplacianCgWork{};  // the AMG is set up again without the column nodes
   return set.count;

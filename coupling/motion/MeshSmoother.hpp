@@ -101,6 +101,8 @@ class MeshSmoother {
   /// `displacement()` before each move (on every rank, a foot's row whether or not its node is on
   /// the rank's part). Empty without columns.
   Real3View columnFeet() const { return columns_.feet; }
+  /// The columns (of `setColumnFeet`'s count) whose nodes more than one rank owns.
+  lid_t columnsAcrossRanks() const { return columns_.acrossRanks; }
 
   /// Smooth and move the mesh points; the quality guard (the minimum scaled Jacobian, from the
   /// points alone) retries as the options say. The caller recomputes whatever geometry it keeps
@@ -141,6 +143,7 @@ class MeshSmoother {
     IndexView node, foot;  ///< every local copy of a column node, and its foot's row of `feet`
     RealView weight;
     Real3View feet;  ///< columnFeet()
+    lid_t acrossRanks = 0;
   };
   Columns columns_;
   LaplacianCgWork cg_;

@@ -1094,6 +1094,7 @@ void FsiCoupling::addMetrics(std::map<std::string, double>& m) const {
   if (options_.motion.columns) {  // how many membrane nodes carry a column (the rim's and the edges' do not)
     m["coupling.mesh_motion_columns"] = double(columns_);
     m["coupling.mesh_motion_column_feet"] = double(columnFeet_);
+    m["coupling.mesh_motion_columns_across_ranks"] = double(smoother_->columnsAcrossRanks());
   }
   m["coupling.unconverged_steps"] = double(unconvergedSteps_);
   m["coupling.min_scaled_jacobian"] = minJacobian_;

@@ -119,6 +119,20 @@ execute_process(COMMAND awk "BEGIN { d = (${x}) - (${y}); if (d < 0) d = -d; exi
 if(NOT acts EQUAL 0 OR NOT n EQUAL 22)
   message(SEND_ERROR "columns: ${n} (want 22), the smallest cell ${y} against ${x} without them")
 endif()
+# across_ranks(<run> <relation> <count>): how many columns run through more than one rank's nodes
+function(across_ranks name relation count)
+  file(READ ${WORK}/${name}/summary.json js)
+  string(JSON a GET "${js}" metrics coupling.mesh_motion_columns_across_ranks)
+  if(NOT a ${relation} ${count})
+    message(SEND_ERROR "${name}: ${a} columns across ranks (want ${relation} ${count})")
+  else()
+    message(STATUS "${name}: ${a} columns across ranks")
+  endif()
+endfunction()
+across_ranks(columns1 EQUAL 0)
+foreach(b ${withColumns})
+  across_ranks(${b} GREATER 0)  # the search handed lines from rank to rank
+endforeach()
 
 # Bitwise repeatable at a given rank count: steps.csv equal without its wall_s column.
 function(rows_without_wall dir out)
@@ -208,6 +222,7 @@ same(vad1 vad2 1e-8 coupling.chamber_pressure fluid.max_velocity mesh.min_scaled
 same(vad1 vad2 1e-10 coupling.chamber_volume)
 same(vad1 vad2 1e-5 membrane.membrane.maxDisplacement membrane.membrane.centreDeflection)
 same(vad1 vad2 0 coupling.mesh_motion_columns)
+across_ranks(vad2 GREATER 0)
 
 # Two screens, each solved only by the rank that owns its cells (one on each rank), the other
 # rank receiving the answer: the same as one rank's to 1e-9 with tight tolerances.
