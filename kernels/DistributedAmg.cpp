@@ -362,7 +362,6 @@ struct ByteCount {
   }
 };
 
-/// Coarsest-level gathers made by every DistributedAmg of this process (DistributedAmg::coarseGathers).
 /// A communicator of a few ranks, freed with its holder.
 class GroupComm {
  public:
@@ -438,6 +437,7 @@ std::vector<T> gatherOnFirst(MPI_Comm group, const std::vector<T>& mine) {
   return all;
 }
 
+/// Coarsest-level gathers made by every DistributedAmg of this process (DistributedAmg::coarseGathers).
 std::int64_t gCoarseGathers = 0;
 
 }  // namespace
@@ -457,11 +457,11 @@ struct DistributedAmg::Impl {
     /// A level moved onto fewer ranks (agglomerateRows): its rows as the finer level's R and P see
     /// them (the layout it was built in) and how they travel to and from the ranks that hold it.
     struct Arrival {
-      bool moved = false;
+      bool moved() const { return halo != nullptr; }
       GroupComm group;                  ///< the ranks whose rows one of them gathers (null: none)
       std::vector<int> counts, displs;  ///< rows per group member, on the group's first member
       lid_t owned = 0, local = 0;       ///< this rank's rows, and rows + ghosts, in that layout
-      std::unique_ptr<Halo> halo;       ///< that layout's halo (the finer level's P's ghost columns)
+      std::unique_ptr<Halo> halo;       ///< that layout's halo (the finer P's ghost columns); null: not moved
     } arrival;
   };
   /// A level in the cycle's precision S (S = double: the level's own matrices and vectors).
@@ -695,7 +695,6 @@ struct DistributedAmg::Impl {
       return (r / newStride) * newStride;
     };
     Level M;
-    M.arrival.moved = true;
     M.arrival.owned = C.hA.nRows;
     M.arrival.local = C.hA.nCols;
     M.arrival.halo = std::make_unique<Halo>(comm, C.plan);
@@ -915,7 +914,7 @@ struct DistributedAmg::Impl {
         C.P = cycleMat<S>(exec, L.P);
         C.R = cycleMat<S>(exec, L.R);
       }
-      if (L.arrival.moved)
+      if (L.arrival.moved())
         for (SView<S>* v : {&C.bArrive, &C.xArrive}) *v = SView<S>(label + "::arrival", L.arrival.local);
       cycle.push_back(std::move(C));
     }
@@ -1014,7 +1013,7 @@ struct DistributedAmg::Impl {
     L.halo->exchange(exec, C.r);
     CycleLevel<S>& N = cyc[l + 1];
     const typename Level::Arrival& a = levels[l + 1].arrival;
-    if (!a.moved) {
+    if (!a.moved()) {
       spmv<S>(exec, 1, C.R, C.r, 0, N.b);
       cycle(exec, cyc, l + 1);
       levels[l + 1].halo->exchange(exec, N.x);

@@ -151,7 +151,8 @@ FsiCoupling::FsiCoupling(const CouplingOptions& options, const SceneConfig& sect
       const std::vector<gid_t>& nodes = p.module->fluidSurface()->fluidNode;
       std::vector<lid_t> row(nodes.size());
       for (std::size_t i = 0; i < nodes.size(); ++i) row[i] = static_cast<lid_t>(feet.size() + i);
-      p.footRow = toDevice(row, "mfsi::coupling::footRow");
+      p.feet = p.iface;
+      p.feet.fluidNode = toDevice(row, "mfsi::coupling::footRow");
       feet.insert(feet.end(), nodes.begin(), nodes.end());
     }
     columnFeet_ = static_cast<lid_t>(feet.size());
@@ -768,7 +769,7 @@ void FsiCoupling::setTrial(InterfaceVector& x) {
         copySegmentToHost(p.iterate, x, p.offset);
         Chamber& c = chambers_[static_cast<std::size_t>(k)];
         c.volumeMiss = std::max(c.volumeMiss, std::abs(s.enclosedVolume(p.iterate) - s.volumeConstraint().target));
-          }
+      }
       s.setTrialDisplacement(p.iterate);
     } else {
       copySegmentToDevice(x, p.offset, s.displacement());
@@ -857,11 +858,7 @@ void FsiCoupling::moveMesh(const InterfaceVector& x) {
           coupling::interfaceDisplacement(exec_, iface, p.iterate, target);
       };
       place(p.iface, smoother_->displacement());  // the membrane's nodes on this rank's part
-      if (p.footRow.extent(0) > 0) {  // the columns' feet: every node, on every rank
-        coupling::MembraneInterface feet = p.iface;
-        feet.fluidNode = p.footRow;
-        place(feet, smoother_->columnFeet());
-      }
+      if (p.feet.nNodes() > 0) place(p.feet, smoother_->columnFeet());  // every node, on every rank
     }
   }
   {

@@ -134,7 +134,9 @@ class FsiCoupling final : public Module {
     /// On several ranks: the rank that solves the membrane (the owner of its faces), which sends
     /// its answer to the others; -1: every rank solves it (one rank, or its faces spread).
     int owner = -1;
-    IndexView footRow;  ///< mesh motion by columns: each node's row of the smoother's columnFeet()
+    /// Mesh motion by columns: `iface` with each node's row of the smoother's columnFeet() for its
+    /// fluid node (every node, on every rank); no nodes without columns.
+    coupling::MembraneInterface feet;
     MembraneSolveReport report;  ///< of the last structure solve
   };
   /// A rigid body of the coupling and the fluid patches it carries.
