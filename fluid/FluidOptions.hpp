@@ -240,6 +240,10 @@ struct FluidOptions {
   /// initial one). In the final solve it saves ~0.1 iterations, less than it costs.
   int pressureFinestSweeps = 2;
   PressurePreconditioner pressurePreconditioner = PressurePreconditioner::Amg;
+  /// On a decomposed mesh, the pressure solve's halo exchanges run while its products multiply
+  /// the rows that read no ghost (see kernels/Blas spmvDotOverlapped, DistributedAmgOptions);
+  /// false: exchange first. The same results bit for bit.
+  bool overlapHalo = true;
   /// Most outer iterations between value refreshes of the pressure preconditioner, counted across
   /// time steps (the first solve always sets it up). A slightly stale AMG hierarchy is still a
   /// good, fixed SPD preconditioner, and its refresh costs about as much as a solve, so it is also

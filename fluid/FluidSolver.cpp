@@ -3,6 +3,7 @@
 #include "core/Error.hpp"
 #include "core/MeshRegions.hpp"
 #include "fluid/MeshFlux.hpp"
+#include "kernels/CsrBuild.hpp"
 #include "kernels/DistributedAmg.hpp"
 
 #include <algorithm>
@@ -305,6 +306,7 @@ CsrMatrix ownedRows(const CsrMatrix& A, lid_t nRows) {
   R.rowPtr = Kokkos::subview(A.rowPtr, Kokkos::make_pair(lid_t(0), nRows + 1));
   R.diagIdx = Kokkos::subview(A.diagIdx, Kokkos::make_pair(lid_t(0), nRows));
   R.runs = CsrRowRuns{};
+  R.ghostSplit = buildGhostSplit(nRows, nRows, R.rowPtr, R.colIdx, R.runs, A.values.label());
   return R;
 }
 
@@ -337,6 +339,7 @@ FluidSolver::FluidSolver(const HexMesh& mesh, const FluidOptions& options, const
                                         << " local cells) is not the mesh's (" << nRows_ << ", " << nCells_ << ")");
     cellHalo_ = std::make_unique<Halo>(domain.comm, domain.cells);
     comm_ = SolverComm(domain.comm, cellHalo_.get());
+    comm_.setOverlap(opt_.overlapHalo);
   }
   MFSI_CHECK(opt_.density > 0, "fluid: density must be positive (key fluid.density)");
   MFSI_CHECK(opt_.viscosity >= 0, "fluid: viscosity must be non-negative (key fluid.viscosity)");
@@ -383,7 +386,9 @@ FluidSolver::FluidSolver(const HexMesh& mesh, const FluidOptions& options, const
     if (opt_.pressurePreconditioner == PressurePreconditioner::Amg) {
       auto gid = Kokkos::create_mirror_view_and_copy(HostSpace(), mesh.cellGlobalIds());
       std::vector<gid_t> ids(gid.data(), gid.data() + nCells_);
-      pressure = std::make_unique<DistributedAmg>(domain.comm, domain.cells, std::move(ids));
+      DistributedAmgOptions amg;
+      amg.overlapExchange = opt_.overlapHalo;
+      pressure = std::make_unique<DistributedAmg>(domain.comm, domain.cells, std::move(ids), amg);
     }
     linear_.distribute(comm_, std::move(pressure));
   }

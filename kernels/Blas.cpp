@@ -81,6 +81,79 @@ double spmvDot(const ExecSpace& exec, const SolverComm& comm, const CsrMatrix& A
       })[0];
 }
 
+namespace detail {
+
+/// The blocks of one part of A's ghost split, each as spmvDot sums it (its rows' products in row
+/// order): y on their rows, each block's sum in partial(block).
+void spmvDotBlocks(const ExecSpace& exec, const CsrMatrix& A, int part, const ConstRealView& x, const RealView& y,
+                   const ConstRealView& w, const RealView& partial) {
+  const CsrGhostSplit& split = A.ghostSplit;
+  const lid_t n = A.nRows, bs = kReductionBlock;
+  const lid_t count = static_cast<lid_t>(split.blocks[part].extent(0));
+  if (useRuns(A)) {
+    const RunView R(A);
+    const lid_t* list = split.blocks[part].data();
+    const lid_t* blockStart = A.runs.blockStart.data();
+    const double* xp = x.data();
+    const double* wp = w.data();
+    double* yp = y.data();
+    double* sums = partial.data();
+    exec.fence();
+    Kokkos::parallel_for("mfsi::kernels::blas::spmvDotOverlapped", hostPolicy(exec, 0, count), [=](lid_t k) {
+      const lid_t blk = list[k];
+      for (lid_t r = blockStart[blk]; r < blockStart[blk + 1]; ++r)
+        forRunRows(R, r, [&](lid_t i, const double* v, const lid_t* off, auto width) {
+          yp[i] = runRowDot(v, xp, i, off, width);
+        });
+      const lid_t end = (blk + 1) * bs < n ? (blk + 1) * bs : n;
+      double s = 0.0;
+      for (lid_t i = blk * bs; i < end; ++i) s += wp[i] * yp[i];
+      sums[blk] = s;
+    });
+    HostExecSpace().fence();
+    return;
+  }
+  const ConstIndexView rowPtr = A.rowPtr, colIdx = A.colIdx, list = split.blocks[part];
+  const ConstRealView val = A.values;
+  Kokkos::parallel_for(
+      "mfsi::kernels::blas::spmvDotOverlapped", RangePolicy(exec, 0, count), KOKKOS_LAMBDA(lid_t k) {
+        const lid_t blk = list(k);
+        const lid_t end = (blk + 1) * bs < n ? (blk + 1) * bs : n;
+        double s = 0.0;
+        for (lid_t i = blk * bs; i < end; ++i) {
+          double ax = 0.0;
+          for (lid_t j = rowPtr(i); j < rowPtr(i + 1); ++j) ax += val(j) * x(colIdx(j));
+          y(i) = ax;
+          s += w(i) * ax;
+        }
+        partial(blk) = s;
+      });
+}
+
+}  // namespace detail
+
+double spmvDotOverlapped(const ExecSpace& exec, const SolverComm& comm, const CsrMatrix& A, const RealView& x,
+                         const RealView& y, const ConstRealView& w) {
+  if (!comm.overlapsGhosts() || A.ghostSplit.empty()) {
+    comm.updateGhosts(exec, x);
+    return spmvDot(exec, comm, A, x, y, w);
+  }
+  const lid_t nBlocks = (A.nRows + kReductionBlock - 1) / kReductionBlock;
+  const RealView partial(
+      Kokkos::view_alloc(Kokkos::WithoutInitializing, "mfsi::kernels::blas::spmvDotOverlapped::partials"), nBlocks);
+  comm.beginGhosts(exec, x);
+  detail::spmvDotBlocks(exec, A, CsrGhostSplit::kInterior, x, y, w, partial);
+  comm.endGhosts(exec, x);
+  detail::spmvDotBlocks(exec, A, CsrGhostSplit::kBoundary, x, y, w, partial);
+  auto host = Kokkos::create_mirror_view(partial);
+  Kokkos::deep_copy(exec, host, partial);
+  exec.fence();
+  double out = 0.0;
+  for (lid_t b = 0; b < nBlocks; ++b) out += host(b);
+  comm.globalSum(&out, 1);
+  return out;
+}
+
 double residual(const ExecSpace& exec, const SolverComm& comm, const CsrMatrix& A, const ConstRealView& x,
                 const ConstRealView& b, const RealView& r) {
   const ConstIndexView rowPtr = A.rowPtr, colIdx = A.colIdx;

@@ -64,6 +64,20 @@ class SolverComm {
   void updateGhosts(const ExecSpace& exec, const Real3View& x) const {
     if (halo_ != nullptr) halo_->exchange(exec, x);
   }
+  /// \brief `updateGhosts` in two halves (Halo::begin and Halo::end), for a product that
+  /// multiplies its interior rows in between (blas::spmvDotOverlapped).
+  void beginGhosts(const ExecSpace& exec, const RealView& x) const {
+    if (halo_ != nullptr) halo_->begin(exec, x);
+  }
+  void endGhosts(const ExecSpace& exec, const RealView& x) const {
+    if (halo_ != nullptr) halo_->end(exec, x);
+  }
+  /// \brief Whether products overlap their ghost updates with their interior rows
+  /// (blas::spmvDotOverlapped): there are ghosts, and `setOverlap` has not turned it off.
+  bool overlapsGhosts() const { return overlap_ && halo_ != nullptr && halo_->neighbours() > 0; }
+  /// \brief Overlap ghost updates with interior work (the default) or not (the same results, bit
+  /// for bit; for comparisons in perf/).
+  void setOverlap(bool on) { overlap_ = on; }
 
  private:
   void gatherSum(double* values, int n) const;
@@ -72,6 +86,7 @@ class SolverComm {
   MPI_Comm comm_ = MPI_COMM_NULL;
   int size_ = 1;
   const Halo* halo_ = nullptr;
+  bool overlap_ = true;
 };
 
 namespace blas {
@@ -311,6 +326,38 @@ void spmvRows(const ExecSpace& exec, const char* label, S alpha, lid_t nRows, co
       });
 }
 
+/// spmvRows over one part of a ghost split (CsrGhostSplit::kInterior or kBoundary): the same
+/// value in every row it writes, so the two parts give spmvRows bit for bit.
+template <class S, class Val, class X, class Y>
+void spmvRowSet(const ExecSpace& exec, const char* label, S alpha, const CsrRowRuns& runs, const IndexView& rowPtr,
+                const IndexView& colIdx, const Val& val, const X& x, S beta, const Y& y, const CsrGhostSplit& split,
+                int part) {
+  if (kHostExec && runs.count > 0) {
+    const RunViewOf<S> R(runs, rowPtr, val.data());
+    const lid_t* list = split.runs[part].data();
+    const S* xp = x.data();
+    S* yp = y.data();
+    exec.fence();
+    Kokkos::parallel_for(
+        label, hostPolicy(exec, 0, static_cast<lid_t>(split.runs[part].extent(0))), [=](lid_t k) {
+          forRunRows(R, list[k], [&](lid_t i, const S* v, const lid_t* off, auto width) {
+            const S t = runRowDot(v, xp, i, off, width);
+            yp[i] = beta == 0 ? alpha * t : alpha * t + beta * yp[i];
+          });
+        });
+    HostExecSpace().fence();
+    return;
+  }
+  const ConstIndexView rp = rowPtr, ci = colIdx, list = split.rows[part];
+  Kokkos::parallel_for(
+      label, RangePolicy(exec, 0, static_cast<lid_t>(list.extent(0))), KOKKOS_LAMBDA(lid_t k) {
+        const lid_t i = list(k);
+        S t = 0;
+        for (lid_t j = rp(i); j < rp(i + 1); ++j) t += val(j) * x(ci(j));
+        y(i) = beta == 0 ? alpha * t : alpha * t + beta * y(i);
+      });
+}
+
 }  // namespace detail
 
 /// \brief y = A x (rows [0, A.nRows); x has A.nCols entries).
@@ -322,6 +369,14 @@ void spmv(const ExecSpace& exec, real alpha, const CsrMatrix& A, const ConstReal
 /// \brief Fused y = A x and return the global w.y (w = x gives the CG curvature p.Ap).
 double spmvDot(const ExecSpace& exec, const SolverComm& comm, const CsrMatrix& A, const ConstRealView& x,
                const RealView& y, const ConstRealView& w);
+
+/// \brief `comm.updateGhosts(x)` then `spmvDot(A, x, y, w)`, with the exchange overlapped by the
+/// product's interior: the exchange begins, the blocks of rows that read no ghost are multiplied
+/// and summed, the exchange ends, the other blocks follow. Bitwise `spmvDot`'s y and sum (the
+/// block partials are added in block order). Needs A.ghostSplit (kernels/CsrBuild); without it,
+/// or when `comm` does not overlap (SolverComm::overlapsGhosts), the two steps one after the other.
+double spmvDotOverlapped(const ExecSpace& exec, const SolverComm& comm, const CsrMatrix& A, const RealView& x,
+                         const RealView& y, const ConstRealView& w);
 
 /// \brief Fused r = b - A x; returns the global r.r.
 double residual(const ExecSpace& exec, const SolverComm& comm, const CsrMatrix& A, const ConstRealView& x,

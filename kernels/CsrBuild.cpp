@@ -91,6 +91,44 @@ CsrRowRuns buildRowRuns(lid_t nRows, const std::vector<lid_t>& rowPtr, const std
   return runs;
 }
 
+CsrGhostSplit buildGhostSplit(lid_t nRows, lid_t firstGhost, const IndexView& rowPtr, const IndexView& colIdx,
+                              const CsrRowRuns& runs, const std::string& label) {
+  const auto ptr = Kokkos::create_mirror_view_and_copy(HostSpace(), rowPtr);
+  const auto col = Kokkos::create_mirror_view_and_copy(HostSpace(), colIdx);
+  std::vector<char> ghostRow(static_cast<std::size_t>(nRows), 0);
+  bool any = false;
+  for (lid_t i = 0; i < nRows; ++i)
+    for (lid_t k = ptr(i); k < ptr(i + 1); ++k)
+      if (col(k) >= firstGhost) {
+        ghostRow[i] = 1;
+        any = true;
+        break;
+      }
+  CsrGhostSplit split;
+  if (!any) return split;
+  // Parts [first, last) of 0..count-1 whose rows are [begin(p), end(p)), each listed as interior or boundary.
+  auto part = [&](lid_t count, auto begin, auto end, IndexView (&out)[2], const char* what) {
+    std::vector<lid_t> lists[2];
+    for (lid_t p = 0; p < count; ++p) {
+      bool ghost = false;
+      for (lid_t i = begin(p); i < end(p) && !ghost; ++i) ghost = ghostRow[i] != 0;
+      lists[ghost ? CsrGhostSplit::kBoundary : CsrGhostSplit::kInterior].push_back(p);
+    }
+    for (int s = 0; s < 2; ++s) out[s] = toDevice(lists[s], label + "::ghostSplit::" + what);
+  };
+  part(
+      nRows, [](lid_t i) { return i; }, [](lid_t i) { return i + 1; }, split.rows, "rows");
+  part(
+      (nRows + kRowBlock - 1) / kRowBlock, [](lid_t b) { return b * kRowBlock; },
+      [&](lid_t b) { return std::min<lid_t>(nRows, (b + 1) * kRowBlock); }, split.blocks, "blocks");
+  if (runs.count > 0) {
+    const auto start = Kokkos::create_mirror_view_and_copy(HostSpace(), runs.start);
+    part(
+        runs.count, [&](lid_t r) { return start(r); }, [&](lid_t r) { return start(r + 1); }, split.runs, "runs");
+  }
+  return split;
+}
+
 lid_t findEntry(const std::vector<lid_t>& rowPtr, const std::vector<lid_t>& colIdx, lid_t row, lid_t col) {
   const auto begin = colIdx.begin() + rowPtr[row], end = colIdx.begin() + rowPtr[row + 1];
   const auto it = std::lower_bound(begin, end, col);
@@ -139,6 +177,8 @@ CellCsr buildCellCsr(const HexMesh& mesh, const std::string& label) {
   opt.label = label;
   CellCsr out;
   out.matrix = finish(nRows, offsets, neighbours, opt);
+  if (nCols > nRows)
+    out.matrix.ghostSplit = buildGhostSplit(nRows, nRows, out.matrix.rowPtr, out.matrix.colIdx, out.matrix.runs, label);
 
   // Face map: search once here so that assembly never searches.
   auto rowPtr = Kokkos::create_mirror_view_and_copy(HostSpace(), out.matrix.rowPtr);

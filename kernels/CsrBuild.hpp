@@ -58,6 +58,11 @@ CellCsr buildCellCsr(const HexMesh& mesh, const std::string& label = "mfsi::kern
 CsrRowRuns buildRowRuns(lid_t nRows, const std::vector<lid_t>& rowPtr, const std::vector<lid_t>& colIdx,
                         const std::string& label);
 
+/// \brief The ghost split (CsrGhostSplit) of a sparsity of nRows rows whose columns from
+/// `firstGhost` on are ghosts (nRows for a rank's square block); empty when no row reads a ghost.
+CsrGhostSplit buildGhostSplit(lid_t nRows, lid_t firstGhost, const IndexView& rowPtr, const IndexView& colIdx,
+                              const CsrRowRuns& runs, const std::string& label);
+
 /// \brief Boundary condition of the model Poisson matrix.
 enum class ModelBoundary {
   Dirichlet,  ///< u = 0 on every side (matrix SPD)

@@ -23,6 +23,20 @@ struct CsrRowRuns {
   IndexView blockStart;    ///< size nBlocks + 1: first run of each block of kRowBlock rows
 };
 
+/// \brief A rank's rows parted by whether they read a ghost column (>= nRows): interior rows can
+/// be multiplied while the ghosts' values are still under way (core/parallel/Halo::begin), the
+/// boundary rows after they have arrived. Three partitions of the same rows: single rows (the row
+/// kernels), row runs (host sweeps, CsrRowRuns) and reduction blocks of kRowBlock rows (products
+/// fused with a sum, whose block partials are then added in block order as without the split). A
+/// run or block is a boundary one when any of its rows is. Empty (no lists) on one rank.
+struct CsrGhostSplit {
+  static constexpr int kInterior = 0, kBoundary = 1;
+  IndexView rows[2];
+  IndexView runs[2];    ///< run indices; empty without runs
+  IndexView blocks[2];  ///< block indices: block b holds rows [b kRowBlock, (b + 1) kRowBlock)
+  bool empty() const { return rows[kInterior].extent(0) + rows[kBoundary].extent(0) == 0; }
+};
+
 /// \brief CSR matrix. Column indices of a row are sorted; the diagonal entry of row i sits at
 /// `diagIdx(i)` for fast access by assembly kernels and Jacobi smoothers.
 struct CsrMatrix {
@@ -33,6 +47,7 @@ struct CsrMatrix {
   IndexView diagIdx; ///< size nRows: position of the diagonal in colIdx (-1 if absent)
   RealView values;   ///< size nnz
   CsrRowRuns runs;   ///< optional (see CsrRowRuns); follows the sparsity
+  CsrGhostSplit ghostSplit;  ///< optional (see CsrGhostSplit); follows the sparsity
 
   lid_t nnz() const { return static_cast<lid_t>(colIdx.extent(0)); }
 };

@@ -234,6 +234,7 @@ struct CycleMat {
   IndexView rowPtr, colIdx;
   SView<S> val;
   CsrRowRuns runs;
+  CsrGhostSplit split;  ///< empty: its products do not overlap the exchange of their x
 };
 
 template <class S>
@@ -261,6 +262,25 @@ template <class S>
 void spmv(const ExecSpace& exec, S alpha, const CycleMat<S>& M, const SView<S>& x, S beta, const SView<S>& y) {
   blas::detail::spmvRows(exec, "mfsi::kernels::damg::spmv", alpha, M.nRows, M.runs, M.rowPtr, M.colIdx, M.val, x,
                          beta, y);
+}
+
+/// halo.exchange(x), then y = alpha M x + beta y; with M's ghost split, the exchange runs while
+/// the rows that read no ghost are multiplied (the same y, bit for bit).
+template <class S>
+void exchangeAndMultiply(const ExecSpace& exec, const Halo& halo, S alpha, const CycleMat<S>& M, const SView<S>& x,
+                         S beta, const SView<S>& y) {
+  if (M.split.empty()) {
+    halo.exchange(exec, x);
+    spmv<S>(exec, alpha, M, x, beta, y);
+    return;
+  }
+  const char* label = "mfsi::kernels::damg::spmv";
+  halo.begin(exec, x);
+  blas::detail::spmvRowSet(exec, label, alpha, M.runs, M.rowPtr, M.colIdx, M.val, x, beta, y, M.split,
+                           CsrGhostSplit::kInterior);
+  halo.end(exec, x);
+  blas::detail::spmvRowSet(exec, label, alpha, M.runs, M.rowPtr, M.colIdx, M.val, x, beta, y, M.split,
+                           CsrGhostSplit::kBoundary);
 }
 
 /// d = c * inv .* r on the first n entries.
@@ -913,11 +933,25 @@ struct DistributedAmg::Impl {
         C.A = cycleMat<S>(exec, L.A);
         C.P = cycleMat<S>(exec, L.P);
         C.R = cycleMat<S>(exec, L.R);
+        // The products' ghost columns: A's and R's those of this level, P's those of the next
+        // level (or of its arrival layout, when it has moved onto fewer ranks).
+        const Level& next = levels[l + 1];
+        splitByGhosts(C.A, L.halo.get(), label + "::A");
+        splitByGhosts(C.R, L.halo.get(), label + "::R");
+        splitByGhosts(C.P, next.arrival.moved() ? next.arrival.halo.get() : next.halo.get(), label + "::P");
       }
       if (L.arrival.moved())
         for (SView<S>* v : {&C.bArrive, &C.xArrive}) *v = SView<S>(label + "::arrival", L.arrival.local);
       cycle.push_back(std::move(C));
     }
+  }
+
+  /// M's ghost split (CsrGhostSplit), whose ghost columns are those of `halo`, when the cycle
+  /// overlaps its exchanges and the halo has neighbours.
+  template <class S>
+  void splitByGhosts(CycleMat<S>& M, const Halo* halo, const std::string& label) const {
+    if (opt.overlapExchange && halo != nullptr && halo->neighbours() > 0)
+      M.split = buildGhostSplit(M.nRows, halo->nOwned(), M.rowPtr, M.colIdx, M.runs, label);
   }
 
   /// After set-up, drop what only the set-up uses: the host copies of the levels, their global
@@ -979,16 +1013,14 @@ struct DistributedAmg::Impl {
     if (fromZeroX) {
       fromZero<S>(exec, n, c0, C.invDiag, C.b, C.r, C.d);
     } else {
-      L.halo->exchange(exec, C.x);
-      spmv<S>(exec, 1, C.A, C.x, 0, C.r);
+      exchangeAndMultiply<S>(exec, *L.halo, 1, C.A, C.x, 0, C.r);
       fromProduct<S>(exec, n, C.b, C.r);
       scaled<S>(exec, n, c0, C.invDiag, C.r, C.d);
     }
     for (int k = 1; k <= opt.chebyshevDegree; ++k) {
       addTo<S>(exec, n, C.d, C.x);
       if (k == opt.chebyshevDegree) break;
-      L.halo->exchange(exec, C.d);
-      spmv<S>(exec, -1, C.A, C.d, 1, C.r);
+      exchangeAndMultiply<S>(exec, *L.halo, -1, C.A, C.d, 1, C.r);
       chebyshevDirection<S>(exec, n, static_cast<S>((2.0 * k - 1.0) / (2.0 * k + 3.0)),
                             static_cast<S>((8.0 * k + 4.0) / ((2.0 * k + 3.0) * rho)), C.invDiag, C.r, C.d);
     }
@@ -1007,26 +1039,22 @@ struct DistributedAmg::Impl {
     }
     Kokkos::deep_copy(exec, C.x, S(0));
     chebyshev(exec, L, C, true);
-    L.halo->exchange(exec, C.x);
-    spmv<S>(exec, 1, C.A, C.x, 0, C.r);
+    exchangeAndMultiply<S>(exec, *L.halo, 1, C.A, C.x, 0, C.r);
     fromProduct<S>(exec, n, C.b, C.r);
-    L.halo->exchange(exec, C.r);
     CycleLevel<S>& N = cyc[l + 1];
     const typename Level::Arrival& a = levels[l + 1].arrival;
     if (!a.moved()) {
-      spmv<S>(exec, 1, C.R, C.r, 0, N.b);
+      exchangeAndMultiply<S>(exec, *L.halo, 1, C.R, C.r, 0, N.b);
       cycle(exec, cyc, l + 1);
-      levels[l + 1].halo->exchange(exec, N.x);
-      spmv<S>(exec, 1, C.P, N.x, 1, C.x);
+      exchangeAndMultiply<S>(exec, *levels[l + 1].halo, 1, C.P, N.x, 1, C.x);
     } else {  // the next level lives on fewer ranks: its b goes there, its x comes back
-      spmv<S>(exec, 1, C.R, C.r, 0, N.bArrive);
+      exchangeAndMultiply<S>(exec, *L.halo, 1, C.R, C.r, 0, N.bArrive);
       if (a.group.get() != MPI_COMM_NULL)
         gatherToFirst<S>(exec, a.group.get(), a.counts, a.displs, a.owned, N.bArrive, N.b);
       cycle(exec, cyc, l + 1);
       if (a.group.get() != MPI_COMM_NULL)
         scatterFromFirst<S>(exec, a.group.get(), a.counts, a.displs, a.owned, N.x, N.xArrive);
-      a.halo->exchange(exec, N.xArrive);
-      spmv<S>(exec, 1, C.P, N.xArrive, 1, C.x);
+      exchangeAndMultiply<S>(exec, *a.halo, 1, C.P, N.xArrive, 1, C.x);
     }
     chebyshev(exec, L, C, false);
   }

@@ -65,6 +65,10 @@ struct DistributedAmgOptions {
   /// float vectors and halo exchanges; the coarsest solve in double), as kernels/Amg's Mixed: about
   /// a third fewer bytes per cycle; set-up computes in double either way. false: double throughout.
   bool mixedPrecision = true;
+  /// Each halo exchange of the cycle runs while the product that needs it multiplies the rows that
+  /// read no ghost (Halo::begin/end, CsrGhostSplit); false: exchange, then multiply. The same
+  /// results bit for bit.
+  bool overlapExchange = true;
 };
 
 /// \brief One level: rows over all ranks, nonzeros over all ranks, and this rank's rows and ghosts.

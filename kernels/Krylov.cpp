@@ -246,8 +246,13 @@ KrylovResult ConjugateGradient::run(const ExecSpace& exec, const CsrMatrix& A, c
   direction(0.0, m);
 
   for (int it = 1; it <= options_.maxIterations; ++it) {
-    comm_.updateGhosts(exec, p);
-    const double pq = lattice ? lattice_.spmvDot(exec, comm_, p, q, p) : blas::spmvDot(exec, comm_, A, p, q, p);
+    double pq = 0.0;
+    if (lattice) {
+      comm_.updateGhosts(exec, p);
+      pq = lattice_.spmvDot(exec, comm_, p, q, p);
+    } else {
+      pq = blas::spmvDotOverlapped(exec, comm_, A, p, q, p);
+    }
     if (!finite(pq)) return finish(KrylovStatus::NotFinite);
     if (pq == 0.0 || rz == 0.0) return finish(KrylovStatus::Breakdown);
     const double alpha = rz / pq;

@@ -6,7 +6,7 @@ namespace mfsi {
 
 namespace {
 constexpr int kHaloTag = 7411;
-std::int64_t gBytes = 0, gMessages = 0, gExchanges = 0;
+std::int64_t gBytes = 0, gMessages = 0, gExchanges = 0, gSplitExchanges = 0;
 double gWaitSeconds = 0;
 static_assert(sizeof(real) == sizeof(double), "the halo sends reals as MPI_DOUBLE");
 }  // namespace
@@ -47,6 +47,7 @@ Halo::~Halo() {
 std::int64_t Halo::allBytesSent() { return gBytes; }
 std::int64_t Halo::allMessagesSent() { return gMessages; }
 std::int64_t Halo::allExchanges() { return gExchanges; }
+std::int64_t Halo::allSplitExchanges() { return gSplitExchanges; }
 double Halo::allTransferSeconds() { return gWaitSeconds; }
 
 std::int64_t Halo::sendBytes(int components) const {
@@ -64,7 +65,9 @@ namespace {
 int requestSet(int components) { return components == 1 ? 0 : components == 3 ? 1 : 2; }
 }  // namespace
 
-void Halo::start(int components) const {
+void Halo::start(const ExecSpace& exec, int components) const {
+  Kokkos::deep_copy(exec, sendHost_, sendBuf_);
+  exec.fence();
   auto& reqs = requests_[requestSet(components)];
   if (reqs.empty()) {
     // Persistent requests on the (fixed) host buffers; a column count picks the message length.
@@ -84,21 +87,20 @@ void Halo::start(int components) const {
       }
     }
   }
-  if (!reqs.empty()) MPI_Startall(static_cast<int>(reqs.size()), reqs.data());
-}
-
-void Halo::finish(int components) const {
-  auto& reqs = requests_[requestSet(components)];
-  if (!reqs.empty()) MPI_Waitall(static_cast<int>(reqs.size()), reqs.data(), MPI_STATUSES_IGNORE);
-}
-
-void Halo::transfer(const ExecSpace& exec, int components) const {
-  Kokkos::deep_copy(exec, sendHost_, sendBuf_);
-  exec.fence();
   const double t0 = MPI_Wtime();
-  start(components);
-  finish(components);
+  if (!reqs.empty()) MPI_Startall(static_cast<int>(reqs.size()), reqs.data());
   gWaitSeconds += MPI_Wtime() - t0;
+  inFlight_ = components;
+}
+
+void Halo::finish(const ExecSpace& exec, int components) const {
+  MFSI_CHECK(inFlight_ == components, "halo: an exchange of " << components << " columns ended while "
+                                                              << (inFlight_ == 0 ? "none" : "another") << " was begun");
+  auto& reqs = requests_[requestSet(components)];
+  const double t0 = MPI_Wtime();
+  if (!reqs.empty()) MPI_Waitall(static_cast<int>(reqs.size()), reqs.data(), MPI_STATUSES_IGNORE);
+  gWaitSeconds += MPI_Wtime() - t0;
+  inFlight_ = 0;
   bytesSent_ += sendBytes(components);
   messagesSent_ += sendMessages();
   gBytes += sendBytes(components);
@@ -118,24 +120,54 @@ KOKKOS_INLINE_FUNCTION real& entry(const Kokkos::View<real* [3][3], MemSpace>& x
 }  // namespace
 
 template <int K, class View>
-void Halo::exchangeColumns(const ExecSpace& exec, const View& x) const {
+void Halo::beginColumns(const ExecSpace& exec, const View& x) const {
   if (neighbours_.empty()) return;
+  // Before the pack: the buffer of an exchange under way is still being sent.
+  MFSI_CHECK(inFlight_ == 0, "halo: an exchange of field '" << x.label() << "' begun while one of " << inFlight_
+                                                           << " column(s) is still under way");
   MFSI_CHECK(static_cast<lid_t>(x.extent(0)) >= nLocal_,
              "halo: field '" << x.label() << "' has " << x.extent(0) << " entries, the halo " << nLocal_);
-  const lid_t nSend = sendOffsets_.back(), nRecv = recvOffsets_.back(), base = nOwned_;
+  const lid_t nSend = sendOffsets_.back();
   auto idx = sendIndices_;
   auto buf = sendBuf_;
   Kokkos::parallel_for(
       "mfsi::core::halo::pack", RangePolicy(exec, 0, nSend), KOKKOS_LAMBDA(lid_t i) {
         for (int k = 0; k < K; ++k) buf(K * i + k) = entry(x, idx(i), k);
       });
-  transfer(exec, K);
+  start(exec, K);
+}
+
+template <int K, class View>
+void Halo::endColumns(const ExecSpace& exec, const View& x) const {
+  if (neighbours_.empty()) return;
+  finish(exec, K);
+  const lid_t nRecv = recvOffsets_.back(), base = nOwned_;
   auto rb = recvBuf_;
   Kokkos::parallel_for(
       "mfsi::core::halo::unpack", RangePolicy(exec, 0, nRecv), KOKKOS_LAMBDA(lid_t i) {
         for (int k = 0; k < K; ++k) entry(x, base + i, k) = rb(K * i + k);
       });
 }
+
+template <int K, class View>
+void Halo::exchangeColumns(const ExecSpace& exec, const View& x) const {
+  beginColumns<K>(exec, x);
+  endColumns<K>(exec, x);
+}
+
+void Halo::begin(const ExecSpace& exec, const RealView& x) const {
+  if (!neighbours_.empty()) ++gSplitExchanges;
+  beginColumns<1>(exec, x);
+}
+
+void Halo::begin(const ExecSpace& exec, const Kokkos::View<float*, MemSpace>& x) const {
+  if (!neighbours_.empty()) ++gSplitExchanges;
+  beginColumns<1>(exec, x);
+}
+
+void Halo::end(const ExecSpace& exec, const RealView& x) const { endColumns<1>(exec, x); }
+
+void Halo::end(const ExecSpace& exec, const Kokkos::View<float*, MemSpace>& x) const { endColumns<1>(exec, x); }
 
 void Halo::exchange(const ExecSpace& exec, const RealView& x) const { exchangeColumns<1>(exec, x); }
 

@@ -48,8 +48,23 @@ class Halo {
   /// \brief The same for the nine entries of an n x 3 x 3 field (a gradient of a vector).
   void exchange(const ExecSpace& exec, const Kokkos::View<real* [3][3], MemSpace>& x) const;
 
-  /// \brief The exchanges above: pack, transfer and unpack a field of K columns (View: K = 1, 3
-  /// or 9). Public only because nvcc compiles extended device lambdas solely in public members.
+  /// \brief An exchange of a one-column field in two halves, so that work which reads no ghost can
+  /// run while the messages are under way: `begin` packs the owners' values and starts the
+  /// messages; `end` waits for them and writes the ghosts. Between the two, neither the owned
+  /// entries that are sent nor the ghosts of `x` may be written, the ghosts not read, and no other
+  /// exchange of this halo begun. begin + end is `exchange`, bit for bit.
+  void begin(const ExecSpace& exec, const RealView& x) const;
+  void begin(const ExecSpace& exec, const Kokkos::View<float*, MemSpace>& x) const;
+  void end(const ExecSpace& exec, const RealView& x) const;
+  void end(const ExecSpace& exec, const Kokkos::View<float*, MemSpace>& x) const;
+
+  /// \brief The exchanges above: pack and start, then finish and unpack, a field of K columns
+  /// (View: K = 1, 3 or 9). Public only because nvcc compiles extended device lambdas solely in
+  /// public members.
+  template <int K, class View>
+  void beginColumns(const ExecSpace& exec, const View& x) const;
+  template <int K, class View>
+  void endColumns(const ExecSpace& exec, const View& x) const;
   template <int K, class View>
   void exchangeColumns(const ExecSpace& exec, const View& x) const;
 
@@ -68,16 +83,18 @@ class Halo {
   static std::int64_t allBytesSent();
   static std::int64_t allMessagesSent();
   static std::int64_t allExchanges();
-  /// \brief Wall seconds this process has spent from starting its halos' messages to their
-  /// completion (the transfer itself and any wait for a neighbour still computing): what
-  /// overlapping an exchange with interior work could at most hide.
+  /// \brief Of those, the exchanges made in two halves (`begin` and `end`) with neighbours.
+  static std::int64_t allSplitExchanges();
+  /// \brief Wall seconds this process has spent in starting its halos' messages and waiting for
+  /// their completion: the transfer itself and any wait for a neighbour still computing; with work
+  /// between `begin` and `end`, what that work did not hide.
   static double allTransferSeconds();
 
  private:
-  void start(int components) const;
-  void finish(int components) const;
-  /// Send buffer filled (device): send, receive, and return the received buffer (device).
-  void transfer(const ExecSpace& exec, int components) const;
+  /// Send buffer filled (device): copy it to the host and start the messages.
+  void start(const ExecSpace& exec, int components) const;
+  /// Wait for the messages and copy what arrived into the receive buffer (device).
+  void finish(const ExecSpace& exec, int components) const;
 
   MPI_Comm comm_ = MPI_COMM_NULL;
   std::vector<int> neighbours_;
@@ -88,6 +105,7 @@ class Halo {
   RealView::HostMirror sendHost_, recvHost_;
   mutable std::int64_t bytesSent_ = 0, messagesSent_ = 0;
   mutable std::vector<MPI_Request> requests_[3];  ///< persistent: [0] one column, [1] three, [2] nine
+  mutable int inFlight_ = 0;                      ///< columns of the exchange begun and not ended; 0: none
 };
 
 }  // namespace mfsi

@@ -105,3 +105,7 @@ TEST(DistributedAmg, CoarseLevelsMoveOntoFewerRanksAsTheyShrink) {
   opt.parts = 2;
   test::checkCoarseLevelsMoveOntoFewerRanks(in, partitionCells(in, opt).cellRank, {2, 2, 1});
 }
+
+TEST(DistributedAmg, OverlappedExchangesGiveTheSameBits) {
+  test::checkOverlapOnBox(box({24, 24, 24}), 2);
+}

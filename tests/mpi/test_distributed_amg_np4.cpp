@@ -43,3 +43,7 @@ TEST(DistributedAmg, CoarseLevelsMoveOntoFewerRanksAsTheyShrink) {
   opt.parts = 4;
   test::checkCoarseLevelsMoveOntoFewerRanks(in, partitionCells(in, opt).cellRank, {4, 2, 1});
 }
+
+TEST(DistributedAmg, OverlappedExchangesGiveTheSameBits) {
+  test::checkOverlapOnBox(box({24, 24, 24}), 4);
+}

@@ -4,7 +4,9 @@
 /// CG on the cell Laplacian of a box, on every rank's part, against the same preconditioner on
 /// the whole mesh in one process: the same answer, and the iterations the decoupled aggregation
 /// costs.
+#include "core/parallel/Partition.hpp"
 #include "kernels/DistributedAmg.hpp"
+#include "support/LocalParts.hpp"
 #include "support/DistributedLaplacian.hpp"
 
 #include <cstdint>
@@ -19,9 +21,10 @@ struct AmgSolve {
 };
 
 inline AmgSolve solveWithAmg(MPI_Comm comm, const HexMesh& mesh, const HaloPlan& plan, const Halo* halo,
-                             const DistributedAmgOptions& options = {}) {
+                             const DistributedAmgOptions& options = {}, bool dropRuns = false) {
   RealView b;
-  const CellCsr csr = laplacian(mesh, "xmin", b);
+  CellCsr csr = laplacian(mesh, "xmin", b);
+  if (dropRuns) csr.matrix.runs = CsrRowRuns{};  // CG's products by rows, as on a device
   auto gid = Kokkos::create_mirror_view_and_copy(Kokkos::HostSpace(), mesh.cellGlobalIds());
   DistributedAmg amg(comm, plan, std::vector<gid_t>(gid.data(), gid.data() + gid.extent(0)), options);
   const ExecSpace exec;
@@ -29,7 +32,9 @@ inline AmgSolve solveWithAmg(MPI_Comm comm, const HexMesh& mesh, const HaloPlan&
   KrylovOptions opt;
   opt.relTol = 1e-12;
   opt.maxIterations = 500;
-  ConjugateGradient cg(opt, comm == MPI_COMM_SELF ? SolverComm{} : SolverComm(comm, halo));
+  SolverComm solverComm = comm == MPI_COMM_SELF ? SolverComm{} : SolverComm(comm, halo);
+  solverComm.setOverlap(options.overlapExchange);
+  ConjugateGradient cg(opt, solverComm);
   RealView x("test::x", mesh.nCells());
   const KrylovResult r = cg.solve(exec, csr.matrix, b, x, amg);
   AmgSolve s;
@@ -126,6 +131,57 @@ inline void checkCoarseLevelsMoveOntoFewerRanks(const HexMeshInput& in, const st
   const AmgComparison spread = checkDistributedAmg(in, cellRank, o);
   for (const auto& l : spread.levels) EXPECT_EQ(l.ranks, ranks);
   EXPECT_GE(DistributedAmg::coarseGathers(), before + spread.many);
+}
+
+/// The CG's and the AMG cycle's exchanges overlapped with the interior rows of their products
+/// (Halo::begin/end, CsrGhostSplit) against made before them: the same iterations and answer bit
+/// for bit, with every split exchange counted (none without overlap). `options` picks the levels
+/// (moved onto fewer ranks or not); `dropRuns` makes CG multiply by rows instead of row runs.
+inline void checkOverlapIsBitwise(const HexMeshInput& in, const std::vector<int>& cellRank,
+                                  DistributedAmgOptions options, bool dropRuns) {
+  int ranks = 1, rank = 0;
+  MPI_Comm_size(MPI_COMM_WORLD, &ranks);
+  MPI_Comm_rank(MPI_COMM_WORLD, &rank);
+  const HexMesh global = buildHexMesh(in);
+  const LocalMeshPart part = localMeshPart(global, cellRank, ranks, rank);
+  const HexMesh local = buildHexMesh(part.input);
+  const Halo halo(MPI_COMM_WORLD, part.cells);
+  AmgSolve solves[2];
+  std::int64_t split[2] = {0, 0};
+  for (int overlap = 0; overlap < 2; ++overlap) {
+    options.overlapExchange = overlap == 1;
+    const std::int64_t before = Halo::allSplitExchanges();
+    solves[overlap] = solveWithAmg(MPI_COMM_WORLD, local, part.cells, &halo, options, dropRuns);
+    split[overlap] = Halo::allSplitExchanges() - before;
+    EXPECT_TRUE(solves[overlap].solve.converged);
+  }
+  EXPECT_EQ(solves[1].solve.iterations, solves[0].solve.iterations);
+  int differ = 0;
+  for (const auto& [g, v] : solves[0].solve.x) differ += solves[1].solve.x.at(g) != v;
+  EXPECT_EQ(differ, 0) << "rank " << rank << ": " << differ << " of " << solves[0].solve.x.size()
+                       << " values differ with the exchanges overlapped";
+  EXPECT_EQ(split[0], 0) << "rank " << rank;
+  // Every CG iteration's product and, per cycle, at least the finest level's 2 x degree + 2
+  // products with an exchange (its smoothings' and residual's, the restriction's, the
+  // prolongation's) overlap theirs; a rank whose rows all read ghosts would split none.
+  const std::int64_t perCycle = 2 * options.chebyshevDegree + 2;
+  EXPECT_GE(split[1], solves[1].solve.iterations * (1 + perCycle)) << "rank " << rank;
+}
+
+/// checkOverlapIsBitwise on `in` under METIS and a random partition into `parts`: levels kept on
+/// every rank and moved onto fewer ranks (the finer prolongation then reads the moved level's
+/// arrival layout); CG by row runs and by rows.
+inline void checkOverlapOnBox(const HexMeshInput& in, int parts) {
+  PartitionOptions opt;
+  opt.parts = parts;
+  const std::vector<int> metis = partitionCells(in, opt).cellRank;
+  DistributedAmgOptions o;
+  o.agglomerateRows = 0;
+  checkOverlapIsBitwise(in, metis, o, false);
+  checkOverlapIsBitwise(in, metis, o, true);
+  o.agglomerateRows = 500;
+  checkOverlapIsBitwise(in, metis, o, false);
+  checkOverlapIsBitwise(in, randomPartition(in.cells.size(), parts), o, false);
 }
 
 }  // namespace mfsi::test

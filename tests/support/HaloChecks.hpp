@@ -57,6 +57,15 @@ inline void checkExchange(const HexMeshInput& in, const std::vector<int>& cellRa
     halo.exchange(exec, x);
     halo.exchange(exec, x3);
     halo.exchange(exec, x);  // the persistent requests run again
+    // In two halves: the ghosts arrive at `end`; a second `begin` before it is refused.
+    Kokkos::deep_copy(hx, x);
+    for (lid_t i = plan.nOwned; i < plan.nLocal; ++i) hx(i) = -1.0;
+    Kokkos::deep_copy(x, hx);
+    halo.begin(exec, x);
+    if (halo.neighbours() > 0) {
+      EXPECT_THROW(halo.begin(exec, x), InputError);
+    }
+    halo.end(exec, x);
     Kokkos::deep_copy(hx, x);
     Kokkos::deep_copy(hx3, x3);
     int bad = 0;
