@@ -242,8 +242,10 @@ struct FluidOptions {
   PressurePreconditioner pressurePreconditioner = PressurePreconditioner::Amg;
   /// On a decomposed mesh, the pressure solve's halo exchanges run while its products multiply
   /// the rows that read no ghost (see kernels/Blas spmvDotOverlapped, DistributedAmgOptions);
-  /// false: exchange first. The same results bit for bit.
-  bool overlapHalo = true;
+  /// false: exchange first. The same results bit for bit. Off by default: on one shared-memory
+  /// node the transfers take 2-5 % of a step, mostly waits for the other rank that no overlap
+  /// hides, and the split products cost 1-3 % more (perf/RESULTS.md).
+  bool overlapHalo = false;
   /// Most outer iterations between value refreshes of the pressure preconditioner, counted across
   /// time steps (the first solve always sets it up). A slightly stale AMG hierarchy is still a
   /// good, fixed SPD preconditioner, and its refresh costs about as much as a solve, so it is also

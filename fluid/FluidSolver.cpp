@@ -298,14 +298,19 @@ lid_t countVelocityFromCells(const ExecSpace& exec, const ConstIndexView& kind, 
 }
 
 /// The first `nRows` rows of A: the same arrays, the row pointer and diagonal cut (the solvers'
-/// view of a decomposed mesh's matrix, whose ghost rows are assembled but not solved for).
+/// view of a decomposed mesh's matrix, whose ghost rows are assembled but not solved for), with
+/// row runs and a ghost split of their own.
 CsrMatrix ownedRows(const CsrMatrix& A, lid_t nRows) {
   CsrMatrix R = A;
   R.nRows = nRows;
   R.nCols = A.nCols;
   R.rowPtr = Kokkos::subview(A.rowPtr, Kokkos::make_pair(lid_t(0), nRows + 1));
   R.diagIdx = Kokkos::subview(A.diagIdx, Kokkos::make_pair(lid_t(0), nRows));
-  R.runs = CsrRowRuns{};
+  // A's runs cover its ghost rows too, and one may run across the last owned row.
+  const auto ptr = Kokkos::create_mirror_view_and_copy(HostSpace(), R.rowPtr);
+  const auto col = Kokkos::create_mirror_view_and_copy(HostSpace(), A.colIdx);
+  R.runs = buildRowRuns(nRows, std::vector<lid_t>(ptr.data(), ptr.data() + nRows + 1),
+                        std::vector<lid_t>(col.data(), col.data() + ptr(nRows)), A.values.label());
   R.ghostSplit = buildGhostSplit(nRows, nRows, R.rowPtr, R.colIdx, R.runs, A.values.label());
   return R;
 }

@@ -53,7 +53,8 @@ struct CellCsr {
 /// internal face (a cell pair sharing several faces gets one entry; both faces map to it).
 CellCsr buildCellCsr(const HexMesh& mesh, const std::string& label = "mfsi::kernels::cellCsr");
 
-/// \brief Row runs (CsrRowRuns) of a square sparsity given on the host (sorted columns per row);
+/// \brief Row runs (CsrRowRuns) of a sparsity given on the host (sorted columns per row; columns
+/// relative to the row, so ghost columns may follow);
 /// empty where the average run would be short. `buildCsr` and `buildCellCsr` attach them already.
 CsrRowRuns buildRowRuns(lid_t nRows, const std::vector<lid_t>& rowPtr, const std::vector<lid_t>& colIdx,
                         const std::string& label);

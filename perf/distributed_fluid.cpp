@@ -4,11 +4,11 @@
 // cut. perf/distributed_fluid.sh runs it over ranks x threads and writes
 // perf/results/distributed_fluid.txt.
 //
-//   mpirun -np 2 build/perf/perf_distributed_fluid 64 [steps] [untimed] [serial|distributed|blocking]
+//   mpirun -np 2 build/perf/perf_distributed_fluid 64 [steps] [untimed] [serial|distributed|overlapped]
 // `serial` (one rank only) is the one-rank solver with its fast paths (fused passes, the lattice
-// AMG); `distributed` (the default) is the decomposed solver, also on one rank; `blocking` is the
-// decomposed solver with the pressure solve's halo exchanges made before the products that need
-// them instead of overlapped with their interior rows (FluidOptions::overlapHalo).
+// AMG); `distributed` (the default) is the decomposed solver, also on one rank; `overlapped` is the
+// decomposed solver with the pressure solve's halo exchanges overlapped with the interior rows of
+// the products that need them (FluidOptions::overlapHalo) instead of made before them.
 #include "core/BlockMesh.hpp"
 #include "core/parallel/Halo.hpp"
 #include "core/parallel/LocalMesh.hpp"
@@ -63,8 +63,8 @@ int main(int argc, char** argv) {
     const int untimed = argc > 3 ? std::atoi(argv[3]) : 5;
     const std::string mode = argc > 4 ? argv[4] : "distributed";
     const bool serial = mode == "serial";
-    if (mode != "serial" && mode != "distributed" && mode != "blocking") {
-      if (rank == 0) std::fprintf(stderr, "mode: serial, distributed or blocking, not '%s'\n", mode.c_str());
+    if (mode != "serial" && mode != "distributed" && mode != "overlapped") {
+      if (rank == 0) std::fprintf(stderr, "mode: serial, distributed or overlapped, not '%s'\n", mode.c_str());
       MPI_Abort(MPI_COMM_WORLD, 2);
     }
     if (serial && ranks > 1) {
@@ -88,7 +88,7 @@ int main(int argc, char** argv) {
       domain.nodes = lp.nodes;
     }
     FluidOptions o = cavityOptions();
-    o.overlapHalo = mode != "blocking";
+    o.overlapHalo = mode == "overlapped";
     const double dt = 0.32 / n;
     FluidSolver fluid(serial ? global : local, o, domain);
     bool ok = true;
@@ -96,7 +96,7 @@ int main(int argc, char** argv) {
     const Halo* halo = fluid.cellHalo();
     const long long bytes0 = halo ? halo->bytesSent() : 0, messages0 = halo ? halo->messagesSent() : 0;
     const long long haloBytes0 = Halo::allBytesSent(), haloMessages0 = Halo::allMessagesSent(),
-                    exchanges0 = Halo::allExchanges(), reductions0 = SolverComm::reductions(),
+                    exchanges0 = Halo::allExchanges(), split0 = Halo::allSplitExchanges(), reductions0 = SolverComm::reductions(),
                     gathers0 = DistributedAmg::coarseGathers();
     const double transfer0 = Halo::allTransferSeconds(), reduction0 = SolverComm::reductionSeconds();
     Kokkos::fence();
@@ -119,6 +119,7 @@ int main(int argc, char** argv) {
     long long totals[3] = {Halo::allBytesSent() - haloBytes0, Halo::allMessagesSent() - haloMessages0, 0};
     long long allTotals[3] = {0, 0, 0};
     MPI_Reduce(totals, allTotals, 3, MPI_LONG_LONG, MPI_SUM, 0, MPI_COMM_WORLD);
+    const long long split = Halo::allSplitExchanges() - split0;
     const long long exchanges = Halo::allExchanges() - exchanges0, reductions = SolverComm::reductions() - reductions0,
                     gathers = DistributedAmg::coarseGathers() - gathers0;
     long long allBytes = 0, allMessages = 0;
@@ -147,13 +148,13 @@ int main(int argc, char** argv) {
       std::printf("n=%d^3 cells=%.0f mode=%s ranks=%d threads=%d edgecut=%lld steps=%d | %.4e s/cell-step, "
                   "%.3f s/step | pressure its/step %.2f, momentum its/step %.2f | cell halo per step (all ranks): "
                   "%.0f messages, %.0f bytes | all halos per step (all ranks): %.0f messages, %.0f bytes; per rank "
-                  "%.1f exchanges, %.1f reductions, %.1f coarse gathers | halo transfers %.1f %%, reductions %.1f %% "
+                  "%.1f exchanges, %.1f reductions, %.1f coarse gathers, %.1f overlapped exchanges | halo transfers %.1f %%, reductions %.1f %% "
                   "of the step (the largest rank's) | interior rows %.1f %%, blocks %.1f %% | ok=%d\n",
                   n, cells, mode.c_str(), ranks, Kokkos::DefaultExecutionSpace().concurrency(),
                   static_cast<long long>(part.edgeCut), timed, wall / (timed * cells), wall / timed,
                   double(pIts) / timed, double(uIts) / timed, double(allMessages) / timed, double(allBytes) / timed,
                   double(allTotals[1]) / timed, double(allTotals[0]) / timed, double(exchanges) / timed,
-                  double(reductions) / timed, double(gathers) / timed, 100 * maxWaits[0] / wall,
+                  double(reductions) / timed, double(gathers) / timed, double(split) / timed, 100 * maxWaits[0] / wall,
                   100 * maxWaits[1] / wall, interiorRows, interiorBlocks, allOk);
     }
     status = allOk ? 0 : 1;
