@@ -96,7 +96,8 @@ int main(int argc, char** argv) {
     const Halo* halo = fluid.cellHalo();
     const long long bytes0 = halo ? halo->bytesSent() : 0, messages0 = halo ? halo->messagesSent() : 0;
     const long long haloBytes0 = Halo::allBytesSent(), haloMessages0 = Halo::allMessagesSent(),
-                    exchanges0 = Halo::allExchanges(), split0 = Halo::allSplitExchanges(), reductions0 = SolverComm::reductions(),
+                    exchanges0 = Halo::allExchanges(), split0 = Halo::allSplitExchanges(),
+                    reductions0 = SolverComm::reductions(),
                     gathers0 = DistributedAmg::coarseGathers();
     const double transfer0 = Halo::allTransferSeconds(), reduction0 = SolverComm::reductionSeconds();
     Kokkos::fence();
