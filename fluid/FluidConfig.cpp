@@ -244,8 +244,8 @@ Schema fluidSchema() {
       .key("preconditioner", Schema::choice("conjugate-gradient preconditioner", {"amg", "jacobi"}), Default("amg"))
       .key("overlapHalo",
            Schema::boolean("on several ranks, run each halo exchange of the pressure solve while its product "
-                           "multiplies the rows that read no ghost (the same results; off: exchange first, faster "
-                           "on one shared-memory node)"),
+                           "multiplies the rows that read no ghost (the same results; off: exchange first; overlap "
+                           "gains nothing on one shared-memory node)"),
            Default(d.overlapHalo))
       .key("preconditionerRefresh",
            Schema::integer("most outer iterations between AMG value refreshes (earlier when the final pressure solve "

@@ -877,6 +877,7 @@ MembraneSolveReport MembraneSolver::solveStep(real dt) {
       const real ga = blas::dot(exec_, SolverComm{}, n3, volumeGrad_, du_) / (1 - af);
       const real gb = blas::dot(exec_, SolverComm{}, n3, volumeGrad_, volumeDu_) / (1 - af);
       if (!(gb > 0)) break;  // the volume does not respond to the free nodes
+      volume_.compliance = gb * (1 - af);  // g.b: gb carries b's (1 - af) divided out
       const real dLambda = -(volumeMiss + ga) / gb;
       blas::axpy(exec_, n3, dLambda, volumeDu_, du_);
       dLambdaStep = dLambda;

@@ -65,6 +65,11 @@ struct MembraneVolumeConstraint {
   real target = 0;        ///< the region's volume change at the end of the step [m^3 for a 3D mesh]
   real lambda = 0;        ///< the multiplier [Pa]: solved; the next solve starts from it
   real tolerance = 1e-12;  ///< |volume change - target| <= tolerance * A0 * lchar (A0 the reference area)
+  /// The volume's response to the multiplier, d(volume change)/d(lambda) = g.b [m^3/Pa], of the last
+  /// Newton iteration of the last constrained step (the step's dynamic stiffness, so it shrinks
+  /// with the time step): what several membranes sharing one multiplier need to split a volume
+  /// between them. Set by `solveStep`; 0 before.
+  real compliance = 0;
 };
 
 /// \brief One membrane: mesh, options, boundary, loads and state.

@@ -68,6 +68,12 @@ TEST(MembraneVolume, ConstrainedStepFindsTheInflationPressure) {
   EXPECT_LE(std::abs(volume - target), 1e-10 * target) << "the volume constraint holds";
   // The discrete sphere's stretch is within 0.6 % of uniform at n = 16 (the inflation test).
   EXPECT_NEAR(vc.lambda, pExact, 0.01 * pExact) << "the multiplier is the inflation pressure";
+  // The volume's response to the multiplier: with negligible mass the step's stiffness is the
+  // static one (times 1 - af, which b undoes), so g.b is dV/dp of the inflated sphere,
+  // dV/dlambda / dp/dlambda = 4 pi lambda^2 (1 - nu) / (h E (1 + 1 / lambda^2)).
+  const double compliance = 4 * M_PI * lambda * lambda * (1 - nu) / (h * E * (1 + 1 / (lambda * lambda)));
+  std::printf("volume compliance %.6g m^3/Pa (the sphere's %.6g)\n", vc.compliance, compliance);
+  EXPECT_NEAR(vc.compliance, compliance, 0.02 * compliance);
 
   // Unconstrained, under the multiplier as a pressure: the same step, the same displacement.
   MembraneLoads loads;
