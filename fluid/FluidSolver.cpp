@@ -299,8 +299,9 @@ lid_t countVelocityFromCells(const ExecSpace& exec, const ConstIndexView& kind, 
 
 /// The first `nRows` rows of A: the same arrays, the row pointer and diagonal cut (the solvers'
 /// view of a decomposed mesh's matrix, whose ghost rows are assembled but not solved for), with
-/// row runs and a ghost split of their own.
-CsrMatrix ownedRows(const CsrMatrix& A, lid_t nRows) {
+/// row runs of their own and, with `ghostSplit` (a solve that overlaps its exchanges), their split
+/// by ghost columns.
+CsrMatrix ownedRows(const CsrMatrix& A, lid_t nRows, bool ghostSplit) {
   CsrMatrix R = A;
   R.nRows = nRows;
   R.nCols = A.nCols;
@@ -311,7 +312,7 @@ CsrMatrix ownedRows(const CsrMatrix& A, lid_t nRows) {
   const auto col = Kokkos::create_mirror_view_and_copy(HostSpace(), A.colIdx);
   R.runs = buildRowRuns(nRows, std::vector<lid_t>(ptr.data(), ptr.data() + nRows + 1),
                         std::vector<lid_t>(col.data(), col.data() + ptr(nRows)), A.values.label());
-  R.ghostSplit = buildGhostSplit(nRows, nRows, R.rowPtr, R.colIdx, R.runs, A.values.label());
+  if (ghostSplit) R.ghostSplit = buildGhostSplit(nRows, nRows, R.rowPtr, R.colIdx, R.runs, A.values.label());
   return R;
 }
 
@@ -385,8 +386,9 @@ FluidSolver::FluidSolver(const HexMesh& mesh, const FluidOptions& options, const
   boundaryVelocityReadsU_ = countVelocityFromCells(exec_, bc_.kind(), nB_) > 0 || bc_.hasValves();
   linear_ = LinearSolver(nCells_, opt_.pressurePreconditioner);
   if (cellHalo_) {
-    AuRows_ = ownedRows(Au_, nRows_);
-    ApRows_ = ownedRows(Ap_, nRows_);
+    // Only the pressure solve overlaps its exchanges (FluidOptions::overlapHalo).
+    AuRows_ = ownedRows(Au_, nRows_, false);
+    ApRows_ = ownedRows(Ap_, nRows_, opt_.overlapHalo);
     std::unique_ptr<Preconditioner> pressure;
     if (opt_.pressurePreconditioner == PressurePreconditioner::Amg) {
       auto gid = Kokkos::create_mirror_view_and_copy(HostSpace(), mesh.cellGlobalIds());
