@@ -23,6 +23,12 @@ namespace {
 
 /// An interface residual this many times the step's smallest one means the iteration diverges.
 constexpr double kResidualGrowthLimit = 1e3;
+/// A region bounded by several membranes: their multipliers agree when they differ by at most this
+/// times fsiTol times the pressure they carry (the largest multiplier or element load), so that
+/// what is left of the disagreement stays far below what the coupling's convergence test sees.
+constexpr double kShareAgreement = 1e-3;
+/// ... and the shares move at most this many times in one structure solve.
+constexpr int kMaxShareRounds = 30;
 
 /// Device flat vector -> a slice of a host interface vector, and back.
 void copySegmentToHost(const ConstRealView& d, InterfaceVector& x, Eigen::Index offset) {
@@ -191,33 +197,39 @@ void FsiCoupling::setUpLumpedChamber(const SceneConfig& section) {
     throw InputError(where, lc.membrane + ": a lumped chamber's volume constraint needs the dynamic analysis");
   if (p.mounted) throw InputError(where, lc.membrane + ": a lumped chamber behind a mounted membrane is not supported yet");
   // The chamber lies on the side the element normals (out of the fluid) point into.
-  addChamber(i, -1, -1, true);
+  addChamber({{i, real(-1)}}, -1, true);
 }
 
-void FsiCoupling::addChamber(int panel, real sign, int fluidRegion, bool lumped) {
+void FsiCoupling::addChamber(const std::vector<std::pair<int, real>>& walls, int fluidRegion, bool lumped) {
   Chamber c;
-  c.panel = panel;
   c.fluidRegion = fluidRegion;
   c.lumped = lumped;
-  MembraneSolver& s = panels_[panel].module->solver();
-  MembraneVolumeConstraint& vc = s.volumeConstraint();
-  vc.active = true;
-  vc.sign = sign;
-  vc.lambda = 0;
-  c.volumeStart = s.enclosedVolume(s.displacement());
-  vc.target = c.volumeStart;
+  for (const auto& [panel, sign] : walls) {
+    MembraneSolver& s = panels_[static_cast<std::size_t>(panel)].module->solver();
+    MembraneVolumeConstraint& vc = s.volumeConstraint();
+    vc.active = true;
+    vc.sign = sign;
+    vc.lambda = 0;
+    ChamberWall w;
+    w.panel = panel;
+    w.volumeStart = s.enclosedVolume(s.displacement());
+    vc.target = w.volumeStart;
+    c.volumeStart += w.volumeStart;
+    c.walls.push_back(w);
+  }
   chambers_.push_back(c);
 }
 
 int FsiCoupling::chamberOf(int panel) const {
   for (std::size_t k = 0; k < chambers_.size(); ++k)
-    if (chambers_[k].panel == panel) return static_cast<int>(k);
+    for (const ChamberWall& w : chambers_[k].walls)
+      if (w.panel == panel) return static_cast<int>(k);
   return -1;
 }
 
 std::string FsiCoupling::chamberName(std::size_t chamber, const std::string& name) const {
   if (chambers_.size() == 1) return name;
-  return name + "." + membraneNames()[static_cast<std::size_t>(chambers_[chamber].panel)];
+  return name + "." + membraneNames()[static_cast<std::size_t>(chambers_[chamber].walls.front().panel)];
 }
 
 void FsiCoupling::setUpChamber(const SceneConfig& section) {
@@ -267,16 +279,12 @@ void FsiCoupling::setUpChamber(const SceneConfig& section) {
   };
   for (int region = 0; region < regions.count; ++region) {
     if (!regions.closed[static_cast<std::size_t>(region)]) continue;
-    int panel = -1;
-    double sign = 0;
+    // A region bounded by several membranes: one multiplier shared by them all.
+    std::vector<std::pair<int, real>> walls;
     for (std::size_t i = 0; i < panels_.size(); ++i) {
       const Panel& p = panels_[i];
       const bool front = sideIn(p, 0, region), back = p.surface.sides() == 2 && sideIn(p, 1, region);
       if (front == back) continue;
-      if (panel >= 0)
-        throw InputError(where, "a closed fluid region is bounded by two membranes (" +
-                                    panels_[panel].module->name() + " and " + p.module->name() +
-                                    "): one volume constraint shared by several membranes is not supported yet");
       if (!p.dynamic)
         throw InputError(where, p.module->name() + " closes a fluid region: its volume constraint needs the "
                                 "dynamic analysis (membranes.N.analysis: dynamic)");
@@ -288,18 +296,17 @@ void FsiCoupling::setUpChamber(const SceneConfig& section) {
         throw InputError(where, p.module->name() + " closes two chambers (" + other + " and a fluid region): one "
                                 "volume constraint per membrane; give one of them a pressure boundary");
       }
-      panel = static_cast<int>(i);
-      sign = front ? 1.0 : -1.0;
+      // The membrane's element normals are the fluid faces' area vectors (the master side's on a
+      // baffle; coupling/interface/MembraneInterface).
+      walls.emplace_back(static_cast<int>(i), front ? real(1) : real(-1));
     }
-    if (panel < 0) {
+    if (walls.empty()) {
       if (f.closedDomain()) return;  // no membrane closes it: the fluid checks that its fluxes balance
       throw InputError(where, "a region of the fluid no pressure boundary reaches is closed by no membrane: its "
                               "pressure level is undefined; give it a pressure boundary or artificial "
                               "compressibility");
     }
-    // The membrane's element normals are the fluid faces' area vectors (the master side's on a
-    // baffle; coupling/interface/MembraneInterface).
-    addChamber(panel, sign, f.closedDomain() ? -1 : registerRegion(region), false);
+    addChamber(walls, f.closedDomain() ? -1 : registerRegion(region), false);
   }
 }
 
@@ -323,16 +330,73 @@ void FsiCoupling::beginChamberStep() {
       const double q = f.prescribedInflow(c.fluidRegion);
       c.volumeStep = (w.dt * q + w.c00 * c.sweptLast) / w.c1;
     }
-    panels_[c.panel].module->solver().volumeConstraint().target = c.volumeStart + c.volumeStep;
+    c.rounds = 0;
+    c.spread = 0;
+    splitTarget(c);
   }
+}
+
+void FsiCoupling::splitTarget(Chamber& c) {
+  // Weights: the walls' compliances (their volume's response to the multiplier; the walls then
+  // start at about one multiplier), or before any solve their areas.
+  std::vector<double> weight;
+  double sum = 0;
+  bool compliant = true;
+  for (const ChamberWall& w : c.walls) compliant = compliant && memberSolver(w).volumeConstraint().compliance > 0;
+  for (const ChamberWall& w : c.walls) {
+    MembraneSolver& s = memberSolver(w);
+    weight.push_back(compliant ? double(s.volumeConstraint().compliance) : double(s.mesh().referenceArea()));
+    sum += weight.back();
+  }
+  for (std::size_t i = 0; i < c.walls.size(); ++i)
+    memberSolver(c.walls[i]).volumeConstraint().target = c.walls[i].volumeStart + c.volumeStep * weight[i] / sum;
+}
+
+bool FsiCoupling::moveShares(Chamber& c, bool resolved) {
+  double sumC = 0, sumCl = 0, scale = 0;
+  for (const ChamberWall& w : c.walls) {
+    const MembraneVolumeConstraint& vc = memberSolver(w).volumeConstraint();
+    if (!(vc.compliance > 0))
+      throw DivergenceError(panels_[static_cast<std::size_t>(w.panel)].module->name() +
+                            ": its volume does not respond to the chamber's pressure (no free node moves it), so "
+                            "the chamber's volume cannot be shared among its membranes");
+    sumC += vc.compliance;
+    sumCl += vc.compliance * vc.lambda;
+    scale = std::max(scale, std::abs(double(vc.lambda)));
+    // The pressure the membrane carries besides the multiplier.
+    auto h = Kokkos::create_mirror_view_and_copy(HostSpace(), panels_[static_cast<std::size_t>(w.panel)].load);
+    for (std::size_t e = 0; e < h.extent(0); ++e) scale = std::max(scale, std::abs(double(h(e))));
+  }
+  const double lambda = sumCl / sumC;
+  double spread = 0;
+  for (const ChamberWall& w : c.walls)
+    spread = std::max(spread, std::abs(memberSolver(w).volumeConstraint().lambda - lambda));
+  c.lambda = lambda;
+  c.spread = scale > 0 ? spread / scale : 0.0;
+  // Shares moved by less than the membranes' volume tolerance move nothing (no wall took a Newton
+  // iteration): the multipliers agree as well as the membrane solves can tell.
+  bool moved = !resolved;
+  for (const ChamberWall& w : c.walls)
+    moved = moved || panels_[static_cast<std::size_t>(w.panel)].report.iterations > 0;
+  if (!moved) return true;
+  if (spread <= kShareAgreement * options_.fsiTol * scale) return true;
+  for (const ChamberWall& w : c.walls) {
+    MembraneVolumeConstraint& vc = memberSolver(w).volumeConstraint();
+    vc.target += vc.compliance * (lambda - vc.lambda);
+  }
+  return false;
 }
 
 void FsiCoupling::checkChamberVolume(const InterfaceVector& x) {
   for (Chamber& c : chambers_) {
-    Panel& p = panels_[c.panel];
-    MembraneSolver& s = p.module->solver();
-    copySegmentToDevice(x, p.offset, p.iterate);
-    c.volumeMiss = std::max(c.volumeMiss, std::abs(s.enclosedVolume(p.iterate) - s.volumeConstraint().target));
+    double volume = 0;
+    for (const ChamberWall& w : c.walls) {
+      Panel& p = panels_[static_cast<std::size_t>(w.panel)];
+      MembraneSolver& s = p.module->solver();
+      copySegmentToDevice(x, p.offset, p.iterate);
+      volume += s.enclosedVolume(p.iterate);
+    }
+    c.volumeMiss = std::max(c.volumeMiss, std::abs(volume - (c.volumeStart + c.volumeStep)));
   }
 }
 
@@ -675,14 +739,43 @@ void FsiCoupling::solveStructure(double t1, double dt) {
   }
   updateFrameInertia();  // the bodies' accelerations of this solve
   // On several ranks each membrane is solved by the rank that owns its faces, the ranks' membranes
-  // at the same time; then every owner sends its answer to the others.
-  for (Panel& p : panels_) {
-    if (p.owner >= 0 && p.owner != rank_) continue;
-    MembraneSolver& s = p.module->solver();
-    p.report = p.dynamic ? s.solveStep(dt) : s.solveStatic(t1);
+  // at the same time; then every owner sends its answer to the others. The walls of a region
+  // bounded by several membranes solve again on their moved shares until their multipliers agree
+  // (each solve starts from its last answer); every rank moves the shares alike.
+  std::vector<char> solve(panels_.size(), 1);
+  for (int round = 1;; ++round) {
+    for (std::size_t i = 0; i < panels_.size(); ++i) {
+      Panel& p = panels_[i];
+      if (!solve[i] || (p.owner >= 0 && p.owner != rank_)) continue;
+      MembraneSolver& s = p.module->solver();
+      p.report = p.dynamic ? s.solveStep(dt) : s.solveStatic(t1);
+    }
+    for (std::size_t i = 0; i < panels_.size(); ++i)
+      if (solve[i] && panels_[i].owner >= 0) shareSolve(panels_[i], t1, dt);
+    const std::vector<char> solved = solve;
+    std::fill(solve.begin(), solve.end(), char(0));
+    bool again = false;
+    for (Chamber& c : chambers_) {
+      if (c.walls.size() < 2 || !solved[static_cast<std::size_t>(c.walls[0].panel)]) continue;
+      c.rounds = std::max(c.rounds, round);
+      c.maxRoundsRun = std::max(c.maxRoundsRun, round);
+      bool converged = true;  // a wall whose solve failed is reported below
+      for (const ChamberWall& w : c.walls)
+        converged = converged && panels_[static_cast<std::size_t>(w.panel)].report.converged;
+      if (!converged || moveShares(c, round > 1)) continue;
+      if (round >= kMaxShareRounds) {
+        std::ostringstream os;
+        os << "coupling: the membranes of a chamber ("
+           << panels_[static_cast<std::size_t>(c.walls[0].panel)].module->name() << ", ...) did not agree on its "
+           << "pressure in " << kMaxShareRounds << " share rounds of the step to t = " << t1
+           << " (multipliers " << c.spread << " of the pressure apart)";
+        throw DivergenceError(os.str());
+      }
+      for (const ChamberWall& w : c.walls) solve[static_cast<std::size_t>(w.panel)] = 1;
+      again = true;
+    }
+    if (!again) break;
   }
-  for (Panel& p : panels_)
-    if (p.owner >= 0) shareSolve(p, t1, dt);
   for (Panel& p : panels_) {
     const MembraneSolveReport& rep = p.report;
     if (!rep.converged || !std::isfinite(rep.relativeResidual)) {
@@ -711,7 +804,7 @@ void FsiCoupling::shareSolve(Panel& p, double t1, double dt) {
   }
   std::size_t n = 0;
   for (const RealView& v : views) n += v.extent(0);
-  constexpr std::size_t kReport = 7;
+  constexpr std::size_t kReport = 8;
   std::vector<double> buffer(n + kReport);
   if (mine) {
     std::size_t at = 0;
@@ -723,7 +816,8 @@ void FsiCoupling::shareSolve(Panel& p, double t1, double dt) {
     const MembraneSolveReport& r = p.report;
     const double tail[kReport] = {r.converged ? 1.0 : 0.0, static_cast<double>(r.iterations),
                                   static_cast<double>(r.linearIterations), static_cast<double>(r.lineSearchSteps),
-                                  r.relativeResidual, r.seconds, s.volumeConstraint().lambda};
+                                  r.relativeResidual, r.seconds, s.volumeConstraint().lambda,
+                                  s.volumeConstraint().compliance};
     std::copy(tail, tail + kReport, buffer.begin() + static_cast<std::ptrdiff_t>(n));
   }
   MPI_Bcast(buffer.data(), static_cast<int>(buffer.size()), MPI_DOUBLE, p.owner, domain_.comm);
@@ -741,6 +835,7 @@ void FsiCoupling::shareSolve(Panel& p, double t1, double dt) {
   r.lineSearchSteps = static_cast<int>(buffer[n + 3]);
   r.relativeResidual = buffer[n + 4];
   r.seconds = buffer[n + 5];
+  s.volumeConstraint().compliance = buffer[n + 7];
   if (p.dynamic)
     s.adoptStep(dt, r, buffer[n + 6]);
   else
@@ -756,25 +851,46 @@ void FsiCoupling::gatherTrial(InterfaceVector& xt) const {
 }
 
 void FsiCoupling::setTrial(InterfaceVector& x) {
+  // A region bounded by several membranes: x's split of the volume among them is the
+  // acceleration's (the mode in which they trade volume through the fluid is where a strong added
+  // mass lives), so only the total is corrected, the miss shared by the walls' compliances (a
+  // uniform change of the region's pressure). The structure solve's shares are kept for its next solve.
+  std::vector<std::pair<MembraneVolumeConstraint*, real>> shares;
+  for (Chamber& c : chambers_) {
+    if (c.walls.size() < 2) continue;
+    std::vector<double> volume;
+    double miss = c.volumeStart + c.volumeStep, sumC = 0;
+    for (const ChamberWall& w : c.walls) {
+      Panel& p = panels_[static_cast<std::size_t>(w.panel)];
+      copySegmentToDevice(x, p.offset, p.iterate);
+      volume.push_back(p.module->solver().enclosedVolume(p.iterate));
+      miss -= volume.back();
+      sumC += memberSolver(w).volumeConstraint().compliance;
+    }
+    for (std::size_t i = 0; i < c.walls.size(); ++i) {
+      MembraneVolumeConstraint& vc = memberSolver(c.walls[i]).volumeConstraint();
+      shares.emplace_back(&vc, vc.target);
+      vc.target = volume[i] + miss * vc.compliance / sumC;
+    }
+  }
   for (std::size_t i = 0; i < panels_.size(); ++i) {
     Panel& p = panels_[i];
     MembraneSolver& s = p.module->solver();
     if (p.dynamic) {
       copySegmentToDevice(x, p.offset, p.iterate);
-      const int k = chamberOf(static_cast<int>(i));
-      if (k >= 0) {
+      if (chamberOf(static_cast<int>(i)) >= 0) {
         // A relaxed iterate misses the volume to second order in its update: the fluid must get one
         // it can follow.
         s.projectOntoVolume(p.iterate);
         copySegmentToHost(p.iterate, x, p.offset);
-        Chamber& c = chambers_[static_cast<std::size_t>(k)];
-        c.volumeMiss = std::max(c.volumeMiss, std::abs(s.enclosedVolume(p.iterate) - s.volumeConstraint().target));
       }
       s.setTrialDisplacement(p.iterate);
     } else {
       copySegmentToDevice(x, p.offset, s.displacement());
     }
   }
+  for (const auto& [vc, share] : shares) vc->target = share;
+  if (!chambers_.empty()) checkChamberVolume(x);
 }
 
 void FsiCoupling::commitStructure() {
@@ -991,34 +1107,41 @@ void FsiCoupling::advance(const TimeState& t) {
   if (!last_.converged && implicit) setTrial(x);
   for (Chamber& c : chambers_) {
     // The fluid mesh ends the step at `good` (the last iterate moved to): the next step's start.
-    Panel& p = panels_[c.panel];
-    MembraneSolver& s = p.module->solver();
-    copySegmentToDevice(good, p.offset, p.iterate);
-    const double v = s.enclosedVolume(p.iterate);
-    c.sweptLast = v - c.volumeStart;
-    c.volumeStart = v;
-    // A lumped chamber's pressure is the multiplier over the outside pressure its membrane's load
-    // is taken against. Behind a baffle the load is the difference across it: the chamber's
-    // pressure is the multiplier plus the fluid's mean over the chamber's cells. Behind a patch:
-    // the multiplier plus the fluid's mean load on the membrane (the fluid's pressure level in a
-    // closed domain is that of its reference cell and drifts with the pressure solver's tolerance;
-    // the multiplier takes up the difference).
-    if (c.lumped) {
-      c.pressure = options_.outsidePressure + s.volumeConstraint().lambda;
-    } else if (p.iface.side != coupling::InterfaceSide::Patch) {
-      const fluid::FluidSolver& f = fluid_->solver();
-      const double mean =
-          c.fluidRegion < 0 ? fluid::meanPressure(f) : fluid::meanPressure(f, f.cellClosedRegion(), c.fluidRegion);
-      c.pressure = s.volumeConstraint().lambda + mean;
-    } else {
+    const double start = c.volumeStart;
+    c.volumeStart = 0;
+    bool patches = true;  // every wall a membrane patch (none a baffle)
+    double pa = 0, a = 0;  // the fluid's load on the walls, integrated, and their area
+    for (ChamberWall& w : c.walls) {
+      Panel& p = panels_[static_cast<std::size_t>(w.panel)];
+      MembraneSolver& s = p.module->solver();
+      copySegmentToDevice(good, p.offset, p.iterate);
+      w.volumeStart = s.enclosedVolume(p.iterate);
+      c.volumeStart += w.volumeStart;
+      patches = patches && p.iface.side == coupling::InterfaceSide::Patch;
       const std::vector<real>& areas = s.mesh().elementAreas();
       auto h = Kokkos::create_mirror_view_and_copy(HostSpace(), p.load);
-      double pa = 0, a = 0;
       for (std::size_t e = 0; e < areas.size(); ++e) {
         pa += areas[e] * h(e);
         a += areas[e];
       }
-      c.pressure = s.volumeConstraint().lambda + (a > 0 ? pa / a : 0.0);
+    }
+    c.sweptLast = c.volumeStart - start;
+    if (c.walls.size() == 1) c.lambda = memberSolver(c.walls[0]).volumeConstraint().lambda;
+    // A lumped chamber's pressure is the multiplier over the outside pressure its membrane's load
+    // is taken against. Behind a baffle the load is the difference across it: the chamber's
+    // pressure is the multiplier plus the fluid's mean over the chamber's cells. Behind patches:
+    // the multiplier plus the fluid's mean load on the membranes (the fluid's pressure level in a
+    // closed domain is that of its reference cell and drifts with the pressure solver's tolerance;
+    // the multiplier takes up the difference).
+    if (c.lumped) {
+      c.pressure = options_.outsidePressure + c.lambda;
+    } else if (!patches) {
+      const fluid::FluidSolver& f = fluid_->solver();
+      const double mean =
+          c.fluidRegion < 0 ? fluid::meanPressure(f) : fluid::meanPressure(f, f.cellClosedRegion(), c.fluidRegion);
+      c.pressure = c.lambda + mean;
+    } else {
+      c.pressure = c.lambda + (a > 0 ? pa / a : 0.0);
     }
     c.maxMissRun = std::max(c.maxMissRun, c.volumeMiss);
   }
@@ -1026,14 +1149,18 @@ void FsiCoupling::advance(const TimeState& t) {
   for (const Chamber& c : chambers_) {
     if (c.lumped) continue;
     // The fluid's pressure level in the chamber takes over the multiplier: its field is then the
-    // physical pressure, and the next step's multiplier is the change of the level over it.
-    Panel& p = panels_[c.panel];
-    MembraneSolver& s = p.module->solver();
-    const real lambda = s.volumeConstraint().lambda, shift = s.volumeConstraint().sign * lambda;
+    // physical pressure, and the next step's multiplier is the change of the level over it (on
+    // several walls, what each one's multiplier differs from the agreed one stays with it).
+    const real lambda = c.lambda;
     fluid_->solver().shiftPressureLevel(c.fluidRegion, lambda);
-    s.shiftMultiplier(-lambda);
-    for (const RealView& v : {p.load, p.loadPrevious, p.filtered})
-      if (v.extent(0) > 0) blas::shift(exec_, static_cast<lid_t>(v.extent(0)), shift, v);
+    for (const ChamberWall& w : c.walls) {
+      Panel& p = panels_[static_cast<std::size_t>(w.panel)];
+      MembraneSolver& s = p.module->solver();
+      const real shift = s.volumeConstraint().sign * lambda;
+      s.shiftMultiplier(-lambda);
+      for (const RealView& v : {p.load, p.loadPrevious, p.filtered})
+        if (v.extent(0) > 0) blas::shift(exec_, static_cast<lid_t>(v.extent(0)), shift, v);
+    }
   }
   advanceLoadFilter();
   fluid_->endStep();
@@ -1064,9 +1191,12 @@ void FsiCoupling::advance(const TimeState& t) {
 std::vector<std::string> FsiCoupling::stepColumns() const {
   std::vector<std::string> c{"iterations",        "displacementResidual", "forceResidual",    "omega",  "columns",
                              "minScaledJacobian", "cutBacks",             "motionIterations", "limited"};
-  for (std::size_t k = 0; k < chambers_.size(); ++k)
+  for (std::size_t k = 0; k < chambers_.size(); ++k) {
     for (const char* name : {"chamberVolumeStep", "chamberVolumeMiss", "chamberPressure"})
       c.push_back(chamberName(k, name));
+    if (chambers_[k].walls.size() > 1)  // the share rounds and the multipliers' last disagreement
+      for (const char* name : {"chamberShareRounds", "chamberMultiplierSpread"}) c.push_back(chamberName(k, name));
+  }
   return c;
 }
 
@@ -1074,7 +1204,10 @@ void FsiCoupling::appendStepValues(std::vector<double>& v) const {
   v.insert(v.end(), {double(last_.iterations), last_.displacementResidual, last_.forceResidual, last_.omega,
                      double(last_.columns), last_.minScaledJacobian, double(last_.cutBacks),
                      double(last_.motionIterations), double(last_.limited)});
-  for (const Chamber& c : chambers_) v.insert(v.end(), {c.volumeStep, c.volumeMiss, c.pressure});
+  for (const Chamber& c : chambers_) {
+    v.insert(v.end(), {c.volumeStep, c.volumeMiss, c.pressure});
+    if (c.walls.size() > 1) v.insert(v.end(), {double(c.rounds), c.spread});
+  }
 }
 
 void FsiCoupling::addMetrics(std::map<std::string, double>& m) const {
@@ -1102,6 +1235,7 @@ void FsiCoupling::addMetrics(std::map<std::string, double>& m) const {
     m[chamberName(k, "coupling.chamber_max_volume_miss")] = c.maxMissRun;
     m[chamberName(k, "coupling.chamber_volume")] = c.volumeStart;
     m[chamberName(k, "coupling.chamber_pressure")] = c.pressure;
+    if (c.walls.size() > 1) m[chamberName(k, "coupling.chamber_max_share_rounds")] = c.maxRoundsRun;
   }
   const auto& all = timers_.all();
   auto seconds = [&](const char* k) {
@@ -1197,8 +1331,15 @@ void FsiCoupling::saveState(io::StateWriter& w) const {
   // "chamber1", "chamber2", ...
   for (std::size_t k = 0; k < chambers_.size(); ++k) {
     const Chamber& c = chambers_[k];
-    w.put(k == 0 ? std::string("chamber") : "chamber" + std::to_string(k),
-          std::vector<double>{c.volumeStart, c.sweptLast, c.maxMissRun, c.volumeStep, c.volumeMiss, c.pressure});
+    const std::string key = k == 0 ? std::string("chamber") : "chamber" + std::to_string(k);
+    w.put(key, std::vector<double>{c.volumeStart, c.sweptLast, c.maxMissRun, c.volumeStep, c.volumeMiss, c.pressure});
+    if (c.walls.size() < 2) continue;
+    // Several walls: each one's start volume and compliance (the next step's split).
+    std::vector<double> walls;
+    for (const ChamberWall& cw : c.walls)
+      walls.insert(walls.end(), {cw.volumeStart, double(memberSolver(cw).volumeConstraint().compliance)});
+    w.put(key + "Walls", walls);
+    w.put(key + "Rounds", std::vector<std::int64_t>{c.maxRoundsRun});
   }
 }
 
@@ -1258,6 +1399,17 @@ void FsiCoupling::loadState(const io::StateReader& r) {
     const auto ch = r.doubles(k == 0 ? std::string("chamber") : "chamber" + std::to_string(k), 6);
     double* to[6] = {&c.volumeStart, &c.sweptLast, &c.maxMissRun, &c.volumeStep, &c.volumeMiss, &c.pressure};
     for (int j = 0; j < 6; ++j) *to[j] = ch[static_cast<std::size_t>(j)];
+    if (c.walls.size() < 2) {
+      c.walls[0].volumeStart = c.volumeStart;
+      continue;
+    }
+    const std::string key = k == 0 ? std::string("chamber") : "chamber" + std::to_string(k);
+    const auto walls = r.doubles(key + "Walls", 2 * static_cast<long long>(c.walls.size()));
+    for (std::size_t i = 0; i < c.walls.size(); ++i) {
+      c.walls[i].volumeStart = walls[2 * i];
+      memberSolver(c.walls[i]).volumeConstraint().compliance = walls[2 * i + 1];
+    }
+    c.maxRoundsRun = static_cast<int>(r.ints(key + "Rounds", 1)[0]);
   }
 }
 

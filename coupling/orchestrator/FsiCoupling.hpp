@@ -31,7 +31,10 @@
 /// pressure as multiplier); every relaxed iterate is moved back onto the constraint before the
 /// fluid sees it, so the pressure equation is consistent in every coupling iteration. After the
 /// step the fluid's pressure level in the chamber takes over the multiplier
-/// (FluidSolver::shiftPressureLevel), so the fluid's field is the physical pressure.
+/// (FluidSolver::shiftPressureLevel), so the fluid's field is the physical pressure. A region
+/// bounded by several membranes shares one multiplier: each membrane solves with a share of the
+/// target, the shares move by compliance until the multipliers agree (Newton on the split), and a
+/// relaxed iterate is moved back onto the region's total only, keeping the acceleration's split.
 ///
 /// Membrane state never leaks from one iteration into the next: a dynamic membrane re-solves the
 /// step from its committed state (MembraneSolver::solveStep) and commits once; the fluid re-solves
@@ -193,13 +196,13 @@ class FsiCoupling final : public Module {
   void setUpParents(const SceneConfig& section);
   void setUpChamber(const SceneConfig& section);
   void setUpLumpedChamber(const SceneConfig& section);
-  /// Panel `panel` closes a new chamber (sign: MembraneVolumeConstraint::sign; fluidRegion: the
-  /// fluid's closed region, -1 for the whole domain or a lumped chamber): its constraint is
-  /// switched on at the volume it has now.
-  void addChamber(int panel, real sign, int fluidRegion, bool lumped);
-  /// The chamber panel `panel` closes, or -1.
+  /// The panels of `walls` (each with its MembraneVolumeConstraint::sign) close a new chamber
+  /// (fluidRegion: the fluid's closed region, -1 for the whole domain or a lumped chamber): their
+  /// constraints are switched on at the volumes they have now.
+  void addChamber(const std::vector<std::pair<int, real>>& walls, int fluidRegion, bool lumped);
+  /// The chamber panel `panel` closes (one of its walls), or -1.
   int chamberOf(int panel) const;
-  /// A chamber's column or metric name: `name` alone with one chamber, `name` + "." + its
+  /// A chamber's column or metric name: `name` alone with one chamber, `name` + "." + its (first)
   /// membrane's name with several.
   std::string chamberName(std::size_t chamber, const std::string& name) const;
   /// The coupled membranes' names as the scene spells them ("<name>" of module "membrane.<name>").
@@ -238,20 +241,43 @@ class FsiCoupling final : public Module {
             limitedTotal_ = 0;
   int maxIterations_ = 0;
   double minJacobian_ = 1;
-  /// A membrane that closes a closed fluid region (or the whole closed domain, or a lumped gas
-  /// chamber behind it), and the volume bookkeeping of its constraint. One per closed region.
+  /// A closed fluid region (or the whole closed domain, or a lumped gas chamber behind a membrane),
+  /// the membranes that bound it, and the volume bookkeeping of their constraint. One per closed
+  /// region. A region bounded by several membranes carries one multiplier (its uniform pressure)
+  /// on all of them: each membrane solves with a share of the region's volume target as its own,
+  /// and the shares move until the multipliers agree (solveStructure).
+  struct ChamberWall {
+    int panel = -1;          ///< index into panels_
+    double volumeStart = 0;  ///< its share of the region's volume change at the step's start
+  };
   struct Chamber {
-    int panel = -1;            ///< index into panels_
+    std::vector<ChamberWall> walls;
     int fluidRegion = -1;      ///< the fluid's closed region (FluidSolver::addClosedRegion); -1: the whole domain
     bool lumped = false;       ///< an unmeshed gas chamber behind the membrane (coupling.lumpedChamber)
     double volumeStart = 0;    ///< the chamber's volume change where the fluid mesh is at the step's start
-    double sweptLast = 0;      ///< what the membrane swept in the last step (the BDF2 mesh flux reads it)
+    double sweptLast = 0;      ///< what the membranes swept in the last step (the BDF2 mesh flux reads it)
     double maxMissRun = 0;     ///< largest volume miss of the run [m^3]
+    int maxRoundsRun = 0;      ///< most share rounds of one structure solve in the run
     // This step's:
     double volumeStep = 0;     ///< the target's change over the step [m^3]
     double volumeMiss = 0;     ///< largest |volume change - target| of its iterates [m^3]
     double pressure = 0;       ///< the chamber's pressure [Pa]
+    double lambda = 0;         ///< the multiplier of the last structure solve (several walls: their agreed one)
+    double spread = 0;         ///< several walls: max |lambda_i - lambda| / the pressure scale, last solve
+    int rounds = 0;            ///< several walls: most share rounds of one structure solve this step
   };
+  /// Several walls: the volume target's split into the membranes' shares at the step's start (by
+  /// their last compliances; by area before the first solve).
+  void splitTarget(Chamber& c);
+  /// Several walls, after every wall solved on its share: the compliance-weighted multiplier, and
+  /// each share moved by C_i (lambda - lambda_i) (the shares keep their sum). Returns true when
+  /// the multipliers agreed to kShareAgreement x fsiTol before the move (nothing moved then), or
+  /// when `resolved` (a solve on moved shares) and no wall took a Newton iteration.
+  bool moveShares(Chamber& c, bool resolved);
+  /// A wall's membrane solver (the panels hold their modules by pointer).
+  MembraneSolver& memberSolver(const ChamberWall& w) const {
+    return panels_[static_cast<std::size_t>(w.panel)].module->solver();
+  }
   std::vector<Chamber> chambers_;
 };
 

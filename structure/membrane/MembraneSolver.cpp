@@ -877,7 +877,7 @@ MembraneSolveReport MembraneSolver::solveStep(real dt) {
       const real ga = blas::dot(exec_, SolverComm{}, n3, volumeGrad_, du_) / (1 - af);
       const real gb = blas::dot(exec_, SolverComm{}, n3, volumeGrad_, volumeDu_) / (1 - af);
       if (!(gb > 0)) break;  // the volume does not respond to the free nodes
-      volume_.compliance = gb * (1 - af);  // g.b: gb carries b's (1 - af) divided out
+      volume_.compliance = gb;  // dV/dlambda = g.du/dlambda = g.b
       const real dLambda = -(volumeMiss + ga) / gb;
       blas::axpy(exec_, n3, dLambda, volumeDu_, du_);
       dLambdaStep = dLambda;
@@ -889,6 +889,10 @@ MembraneSolveReport MembraneSolver::solveStep(real dt) {
     // wrinkled and slack, where the tangent jumps by E h: a full Newton step from a slack region
     // can overshoot into a stiff one and back, step after step.
     const real g0 = blas::dot(exec_, SolverComm{}, n3, du_, rhs);
+    // A step from equilibrium towards a moved volume target (membranes sharing a multiplier move
+    // their shares between solves) is the constraint's alone: du . rhs starts at round-off, so
+    // the search would cut the step to nothing. It is taken whole (linear in the target).
+    const bool constraintStep = constrained && rel <= options_.tolerance;
     Kokkos::deep_copy(exec_, lineStart_, uTrial_);
     const real lambdaStart = volume_.lambda;
     auto tryStep = [&](real alpha) {
@@ -905,7 +909,7 @@ MembraneSolveReport MembraneSolver::solveStep(real dt) {
         bestG = std::abs(g);
         bestAlpha = alpha;
       }
-      if (!(g0 > 0) || (std::isfinite(g) && std::abs(g) <= 0.5 * g0)) break;
+      if (!(g0 > 0) || constraintStep || (std::isfinite(g) && std::abs(g) <= 0.5 * g0)) break;
       if (evals > nopt.maxLineSearchSteps) {
         if (alpha != bestAlpha) tryStep(bestAlpha);
         break;

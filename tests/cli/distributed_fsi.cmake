@@ -17,6 +17,8 @@
 # - Mesh motion by columns (the cavity's, from the membrane to the lid): the same columns and
 #   answer on 2 and 4 ranks to 1e-10; the VAD pump with both chambers meshed (columns on both
 #   sides of the membrane, the air a closed chamber) for 5 ms on 2 ranks as on one.
+# - One region bounded by two membranes (their shared multiplier), each solved by its own rank:
+#   the same as one rank's (deflections 1e-8, volume 1e-10, pressure 2e-6).
 # - Two screens far apart: each solved by its own rank only (one per rank), the answer sent to
 #   the other: the same as one rank's to 1e-9.
 # - `mfsi partition` writes the map a run computes: the cavity run on 2 ranks with --partition
@@ -202,6 +204,27 @@ run(balloon2 2 ${balloon} ${tight})
 same(balloon1 balloon2 1e-8 membrane.top.centreUy)
 same(balloon1 balloon2 1e-10 coupling.chamber_volume)
 same(balloon1 balloon2 1e-6 coupling.chamber_pressure)
+
+# One region bounded by two membranes (tests/data/balloon_shared.yaml), each solved by its own
+# rank, sharing the region's multiplier: the share rounds run on both ranks alike (each owner
+# sends its membrane's multiplier and compliance). On 2 ranks as on one: the deflections to 1e-8,
+# the region's volume to 1e-10, its pressure to 2e-6 (measured 1.1e-10, 5e-12, 3.4e-7 at 2 s).
+if(SHORT)
+  set(shared ${DATA}/balloon_shared.yaml --set time.endTime=0.5)
+else()
+  set(shared ${DATA}/balloon_shared.yaml --set time.endTime=2)
+endif()
+run(shared1 1 ${shared} ${tight})
+run(shared2 2 ${shared} ${tight})
+same(shared1 shared2 1e-8 membrane.topA.centreUy membrane.topB.centreUy)
+same(shared1 shared2 1e-10 coupling.chamber_volume)
+same(shared1 shared2 2e-6 coupling.chamber_pressure)
+file(READ ${WORK}/shared2/summary.json js)
+string(JSON a GET "${js}" metrics coupling.membrane.topA.solved_on_rank)
+string(JSON b GET "${js}" metrics coupling.membrane.topB.solved_on_rank)
+if(a EQUAL b OR a LESS 0 OR b LESS 0)
+  message(SEND_ERROR "the shared region on 2 ranks: its membranes solved on ranks ${a} and ${b} (want one each)")
+endif()
 
 # The VAD pump with both chambers meshed (cases/vad-two-chambers.yaml: the air closed by the
 # membrane's volume constraint, the mesh moved by 482 columns on both sides of the membrane, which
