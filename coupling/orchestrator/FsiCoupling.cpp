@@ -5,6 +5,7 @@
 #include "core/io/HostCopy.hpp"
 
 #include "core/Error.hpp"
+#include "core/HexGeometry.hpp"
 #include "core/Suggest.hpp"
 #include "fluid/BoundaryConditions.hpp"
 #include "fluid/Loads.hpp"
@@ -220,6 +221,71 @@ void FsiCoupling::addChamber(const std::vector<std::pair<int, real>>& walls, int
   chambers_.push_back(c);
 }
 
+int FsiCoupling::singleParent(const Panel& p) const {
+  const std::size_t n = static_cast<std::size_t>(p.module->solver().mesh().nNodes());
+  for (int slot = 0; slot < p.parents.nBodies(); ++slot) {
+    bool all = true;
+    for (std::size_t i = 0; i < n && all; ++i) all = p.parents.weight(i, slot) == 1.0;
+    if (all) return slot;
+  }
+  return -1;
+}
+
+void FsiCoupling::addMovingWalls(Chamber& c, const std::vector<int>& cellRegion, int region) {
+  for (ChamberWall& w : c.walls) {
+    const Panel& p = panels_[static_cast<std::size_t>(w.panel)];
+    if (!p.mounted) continue;
+    w.parent = singleParent(p);
+    const MembraneMesh& mm = p.module->solver().mesh();
+    w.rigid = RealView("mfsi::coupling::chamberRigidWall", 3 * mm.nNodes());
+    w.pressure = RealView("mfsi::coupling::chamberWallMultiplier", mm.nElements());
+  }
+  // The bodies' faces on the region, each counted by the rank that owns its cell.
+  const fluid::FluidSolver& f = fluid_->solver();
+  auto X = Kokkos::create_mirror_view_and_copy(HostSpace(), mesh_.referencePoints());
+  auto fn = Kokkos::create_mirror_view_and_copy(HostSpace(), mesh_.faceNodes());
+  auto own = Kokkos::create_mirror_view_and_copy(HostSpace(), mesh_.faceOwner());
+  const lid_t nOwned = f.ownedCells();
+  for (std::size_t slot = 0; slot < bodies_.size(); ++slot) {
+    ChamberBody b;
+    b.slot = static_cast<int>(slot);
+    double sums[7] = {0, 0, 0, 0, 0, 0, 0};  // area vector, moment, face count
+    for (const std::string& name : bodies_[slot].patches)
+      for (int pi : f.boundaryConditions().find(name)) {
+        const Patch& patch = mesh_.patches()[static_cast<std::size_t>(pi)];
+        for (lid_t face = patch.start; face < patch.start + patch.size; ++face) {
+          const lid_t cell = own(face);
+          if (cell >= nOwned || cellRegion[static_cast<std::size_t>(cell)] != region) continue;
+          std::array<double, 12> corners;
+          double q[4][3];
+          for (int a = 0; a < 4; ++a)
+            for (int k = 0; k < 3; ++k) corners[3 * a + k] = q[a][k] = X(fn(face, a), k);
+          double area[3], centre[3], magnitude = 0;
+          geom::quadAreaVector(q, area);
+          geom::quadCentroid(q, centre, magnitude);
+          const Eigen::Vector3d S(area[0], area[1], area[2]);
+          const Eigen::Vector3d r = Eigen::Vector3d(centre[0], centre[1], centre[2]) - bodies_[slot].com0;
+          const Eigen::Vector3d m = r.cross(S);
+          for (int k = 0; k < 3; ++k) {
+            sums[k] += S[k];
+            sums[3 + k] += m[k];
+          }
+          sums[6] += 1;
+          b.faces.push_back(corners);
+        }
+      }
+    if (domain_.distributed()) MPI_Allreduce(MPI_IN_PLACE, sums, 7, MPI_DOUBLE, MPI_SUM, domain_.comm);
+    if (sums[6] == 0) continue;  // on every rank alike
+    b.area = Eigen::Vector3d(sums[0], sums[1], sums[2]);
+    b.moment = Eigen::Vector3d(sums[3], sums[4], sums[5]);
+    c.bodies.push_back(std::move(b));
+  }
+  if (!c.moving()) return;
+  // The volume change at the start (zero: the bodies and walls at their reference places), the
+  // walls' frame-relative ones added.
+  c.rigidStart = c.rigidNow = 0;
+}
+
 int FsiCoupling::chamberOf(int panel) const {
   for (std::size_t k = 0; k < chambers_.size(); ++k)
     for (const ChamberWall& w : chambers_[k].walls)
@@ -288,9 +354,10 @@ void FsiCoupling::setUpChamber(const SceneConfig& section) {
       if (!p.dynamic)
         throw InputError(where, p.module->name() + " closes a fluid region: its volume constraint needs the "
                                 "dynamic analysis (membranes.N.analysis: dynamic)");
-      if (p.mounted)
-        throw InputError(where, p.module->name() + " closes a fluid region on moving bodies: a volume constraint "
-                                "for a mounted membrane is not supported yet");
+      if (p.mounted && singleParent(p) < 0)
+        throw InputError(where, p.module->name() + " closes a fluid region on several moving bodies "
+                                "(parentBodyPatches of two bodies): a volume constraint for a membrane blended "
+                                "between bodies is not supported; mount it on one body");
       if (const int k = chamberOf(static_cast<int>(i)); k >= 0) {
         const std::string other = chambers_[static_cast<std::size_t>(k)].lumped ? "a lumped one" : "a fluid region";
         throw InputError(where, p.module->name() + " closes two chambers (" + other + " and a fluid region): one "
@@ -307,6 +374,7 @@ void FsiCoupling::setUpChamber(const SceneConfig& section) {
                               "compressibility");
     }
     addChamber(walls, f.closedDomain() ? -1 : registerRegion(region), false);
+    addMovingWalls(chambers_.back(), regions.cellRegion, region);
   }
 }
 
@@ -331,7 +399,9 @@ void FsiCoupling::beginChamberStep() {
       c.volumeStep = (w.dt * q + w.c00 * c.sweptLast) / w.c1;
     }
     c.rounds = 0;
+    c.sweeps = 0;
     c.spread = 0;
+    c.rigidNow = c.rigidStart;  // the bodies at the step's start: followBodies moves the targets on
     splitTarget(c);
   }
 }
@@ -353,7 +423,7 @@ void FsiCoupling::splitTarget(Chamber& c) {
 }
 
 bool FsiCoupling::moveShares(Chamber& c, bool resolved) {
-  double sumC = 0, sumCl = 0, scale = 0;
+  double sumC = 0, sumCl = 0;
   for (const ChamberWall& w : c.walls) {
     const MembraneVolumeConstraint& vc = memberSolver(w).volumeConstraint();
     if (!(vc.compliance > 0))
@@ -362,11 +432,9 @@ bool FsiCoupling::moveShares(Chamber& c, bool resolved) {
                             "the chamber's volume cannot be shared among its membranes");
     sumC += vc.compliance;
     sumCl += vc.compliance * vc.lambda;
-    scale = std::max(scale, std::abs(double(vc.lambda)));
-    // The pressure the membrane carries besides the multiplier.
-    auto h = Kokkos::create_mirror_view_and_copy(HostSpace(), panels_[static_cast<std::size_t>(w.panel)].load);
-    for (std::size_t e = 0; e < h.extent(0); ++e) scale = std::max(scale, std::abs(double(h(e))));
   }
+  // The pressure the walls carry: the multipliers and the fluid's loads.
+  const double scale = pressureScale(c);
   const double lambda = sumCl / sumC;
   double spread = 0;
   for (const ChamberWall& w : c.walls)
@@ -388,8 +456,9 @@ bool FsiCoupling::moveShares(Chamber& c, bool resolved) {
 }
 
 void FsiCoupling::checkChamberVolume(const InterfaceVector& x) {
+  const Eigen::VectorXd q = bodyCoordinates(x);
   for (Chamber& c : chambers_) {
-    double volume = 0;
+    double volume = rigidVolumeAt(c, q);
     for (const ChamberWall& w : c.walls) {
       Panel& p = panels_[static_cast<std::size_t>(w.panel)];
       MembraneSolver& s = p.module->solver();
@@ -397,6 +466,68 @@ void FsiCoupling::checkChamberVolume(const InterfaceVector& x) {
       volume += s.enclosedVolume(p.iterate);
     }
     c.volumeMiss = std::max(c.volumeMiss, std::abs(volume - (c.volumeStart + c.volumeStep)));
+  }
+}
+
+double FsiCoupling::rigidVolume(Chamber& c, const std::vector<RigidPlacement>& t) {
+  // The bodies' faces: the exact trilinear volume each sweeps from its reference corners to
+  // their rigidly moved places (what the fluid's swept-volume fluxes of those faces add up to).
+  double v = 0;
+  for (const ChamberBody& b : c.bodies)
+    for (const auto& f : b.faces) {
+      double hex[8][3];
+      for (int a = 0; a < 4; ++a) {
+        const std::array<real, 3> X{f[3 * a], f[3 * a + 1], f[3 * a + 2]};
+        const std::array<real, 3> y = t[static_cast<std::size_t>(b.slot)].apply(X);
+        for (int k = 0; k < 3; ++k) {
+          hex[a][k] = X[k];
+          hex[a + 4][k] = y[k];
+        }
+      }
+      v += geom::hexVolume(hex);
+    }
+  if (domain_.distributed() && !c.bodies.empty()) MPI_Allreduce(MPI_IN_PLACE, &v, 1, MPI_DOUBLE, MPI_SUM, domain_.comm);
+  // Mounted walls carried undeformed by their body: a rigid motion keeps the volume between the
+  // carried and the deformed membrane, so the frame-relative volume adds to this exactly.
+  for (ChamberWall& w : c.walls) {
+    if (w.parent < 0) continue;
+    MembraneSolver& s = memberSolver(w);
+    const auto& X = s.mesh().hostPoints();
+    auto h = Kokkos::create_mirror_view(w.rigid);
+    for (std::size_t i = 0; i < X.size(); ++i) {
+      const std::array<real, 3> y = t[static_cast<std::size_t>(w.parent)].apply(X[i]);
+      for (int k = 0; k < 3; ++k) h(3 * i + k) = y[k] - X[i][k];
+    }
+    Kokkos::deep_copy(w.rigid, h);
+    v += s.enclosedVolume(w.rigid);
+  }
+  return v;
+}
+
+double FsiCoupling::rigidVolumeAt(Chamber& c, const Eigen::VectorXd& q) {
+  if (q.size() == 0 || !c.moving()) return 0;
+  return rigidVolume(c, placementsOf(q));
+}
+
+Eigen::VectorXd FsiCoupling::bodyCoordinates(const InterfaceVector& x) const {
+  if (bodies_.empty()) return {};
+  return x.segment(bodyOffset_, rigid_->system().nDof());
+}
+
+void FsiCoupling::followBodies() {
+  if (bodies_.empty()) return;
+  const Eigen::VectorXd q = rigid_->system().q();
+  for (Chamber& c : chambers_) {
+    const double r = rigidVolumeAt(c, q), d = r - c.rigidNow;
+    if (d == 0) continue;
+    c.rigidNow = r;
+    // The walls' total follows; its split stays (by compliance, by area before any solve).
+    double sum = 0;
+    for (const ChamberWall& w : c.walls) sum += memberSolver(w).volumeConstraint().compliance;
+    for (const ChamberWall& w : c.walls) {
+      MembraneVolumeConstraint& vc = memberSolver(w).volumeConstraint();
+      vc.target -= d * (sum > 0 ? vc.compliance / sum : 1.0 / double(c.walls.size()));
+    }
   }
 }
 
@@ -723,21 +854,135 @@ void FsiCoupling::updateBodyLoads(double scale, bool stepStart) {
       if (p.dynamic && p.parents.hasAccelerations())
         add(p.parents.nodeLoad(exec_, s, {c[0], c[1], c[2]}, p.nodePosition, p.reaction));
     }
+    bodies_[slot].loadCentre = c;
+    bodies_[slot].loadForce = force;
+    bodies_[slot].loadMoment = moment;
+  }
+  applyBodyLoads();
+}
+
+void FsiCoupling::applyBodyLoads() {
+  if (bodies_.empty()) return;
+  RigidBodySystem& sys = rigid_->system();
+  for (std::size_t slot = 0; slot < bodies_.size(); ++slot) {
+    const CoupledBody& b = bodies_[slot];
+    Eigen::Vector3d force = b.loadForce, moment = b.loadMoment;
+    const Eigen::Vector3d& c = b.loadCentre;
+    // A chamber's multiplier (the part of its pressure the fluid's level does not carry yet) on
+    // the body's faces that bound it and on the mounted walls it carries, as those walls receive it.
+    for (Chamber& ch : chambers_) {
+      // Weighted between the step's ends as the walls' integrator weighs their multiplier (a body
+      // that took it at the step's end alone would make the two trade it back and forth, growing).
+      const double af = memberSolver(ch.walls[0]).startLoadWeight();
+      const double lambda = (1 - af) * ch.bodyLambda + af * ch.bodyLambdaStart;
+      if (lambda == 0) continue;
+      const RigidPlacement& t = transforms_[slot];
+      Eigen::Matrix3d Q;
+      for (int i = 0; i < 3; ++i)
+        for (int j = 0; j < 3; ++j) Q(i, j) = t.rotation[i][j];
+      const Eigen::Vector3d lever(t.placed[0] - c[0], t.placed[1] - c[1], t.placed[2] - c[2]);
+      for (const ChamberBody& cb : ch.bodies) {
+        if (cb.slot != static_cast<int>(slot)) continue;
+        const Eigen::Vector3d f = lambda * (Q * cb.area);
+        force += f;
+        moment += lambda * (Q * cb.moment) + lever.cross(f);
+      }
+      for (ChamberWall& w : ch.walls) {
+        if (w.parent != static_cast<int>(slot)) continue;
+        const Panel& p = panels_[static_cast<std::size_t>(w.panel)];
+        MembraneSolver& s = memberSolver(w);
+        Kokkos::deep_copy(exec_, w.pressure, s.volumeConstraint().sign * lambda);
+        const std::array<double, 6> L = p.parents.bodyLoad(exec_, static_cast<int>(slot), {c[0], c[1], c[2]},
+                                                          s.mesh().elementNodes(), w.pressure, p.iface.front, 0,
+                                                          p.surface.faceArea(), p.surface.faceCentroid());
+        for (int k = 0; k < 3; ++k) {
+          force[k] += L[k];
+          moment[k] += L[3 + k];
+        }
+      }
+    }
     sys.setExternalLoad(b.index, force, moment);
   }
 }
 
 void FsiCoupling::solveStructure(double t1, double dt) {
   ScopedTimer timer(timers_, "coupling.structure");
-  if (!bodies_.empty()) {
-    RigidBodySystem& sys = rigid_->system();
-    try {
-      sys.solveStep(sys.time(), dt);
-    } catch (const DivergenceError& e) {
-      throw DivergenceError(std::string("bodies: the rigid step to t = ") + std::to_string(t1) + " failed: " + e.what());
+  // Chambers with moving walls: the bodies move under the chamber's multiplier, the walls'
+  // volumes take what the bodies' motion leaves, and their multiplier is the chamber's. The
+  // multiplier the bodies are solved with is iterated by secant until the walls return it.
+  const bool moving = std::any_of(chambers_.begin(), chambers_.end(), [](const Chamber& c) { return c.moving(); });
+  std::vector<double> lambdaLast(chambers_.size()), missLast(chambers_.size());
+  for (int sweep = 0;; ++sweep) {
+    if (!bodies_.empty()) {
+      RigidBodySystem& sys = rigid_->system();
+      try {
+        sys.solveStep(sys.time(), dt);
+      } catch (const DivergenceError& e) {
+        throw DivergenceError(std::string("bodies: the rigid step to t = ") + std::to_string(t1) +
+                              " failed: " + e.what());
+      }
+    }
+    updateFrameInertia();  // the bodies' accelerations of this solve
+    followBodies();        // chambers the bodies bound: the walls' targets at the bodies' trial places
+    solveMembranes(t1, dt);
+    if (!moving || std::any_of(panels_.begin(), panels_.end(), [](const Panel& p) { return !p.report.converged; }))
+      break;  // a failed solve is reported below
+    bool again = false;
+    for (std::size_t k = 0; k < chambers_.size(); ++k) {
+      Chamber& c = chambers_[k];
+      if (!c.moving()) continue;
+      const double lambda = c.walls.size() > 1 ? c.lambda : double(memberSolver(c.walls[0]).volumeConstraint().lambda);
+      const double miss = lambda - c.bodyLambda;
+      bool moved = sweep == 0;  // a sweep whose walls took no Newton iteration can tell no more
+      for (const ChamberWall& w : c.walls)
+        moved = moved || panels_[static_cast<std::size_t>(w.panel)].report.iterations > 0;
+      if (!moved || std::abs(miss) <= kShareAgreement * options_.fsiTol * pressureScale(c)) continue;
+      if (sweep >= kMaxShareRounds) {
+        std::ostringstream os;
+        os << "coupling: the bodies and the membranes of a chamber ("
+           << panels_[static_cast<std::size_t>(c.walls[0].panel)].module->name() << ", ...) did not agree on its "
+           << "pressure in " << kMaxShareRounds << " sweeps of the step to t = " << t1
+           << " (" << lambda << " Pa against " << c.bodyLambda << ")";
+        throw DivergenceError(os.str());
+      }
+      const double next = sweep == 0 || miss == missLast[k]
+                              ? lambda
+                              : c.bodyLambda - miss * (c.bodyLambda - lambdaLast[k]) / (miss - missLast[k]);
+      lambdaLast[k] = c.bodyLambda;
+      missLast[k] = miss;
+      c.bodyLambda = next;
+      c.sweeps = std::max(c.sweeps, sweep + 1);
+      c.maxSweepsRun = std::max(c.maxSweepsRun, c.sweeps);
+      again = true;
+    }
+    if (!again) break;
+    applyBodyLoads();
+  }
+  for (Panel& p : panels_) {
+    const MembraneSolveReport& rep = p.report;
+    if (!rep.converged || !std::isfinite(rep.relativeResidual)) {
+      std::ostringstream os;
+      os << p.module->name() << ": the structure solve did not converge in the step to t = " << t1 << " ("
+         << (last_.iterations == 0 ? std::string("the predictor on the loads of t_n")
+                                   : "coupling iteration " + std::to_string(last_.iterations))
+         << "; " << rep.iterations << " Newton iterations, relative residual " << rep.relativeResidual << ")";
+      throw DivergenceError(os.str());
     }
   }
-  updateFrameInertia();  // the bodies' accelerations of this solve
+  ++last_.structureSolves;
+}
+
+double FsiCoupling::pressureScale(const Chamber& c) const {
+  double scale = 0;
+  for (const ChamberWall& w : c.walls) {
+    scale = std::max(scale, std::abs(double(memberSolver(w).volumeConstraint().lambda)));
+    auto h = Kokkos::create_mirror_view_and_copy(HostSpace(), panels_[static_cast<std::size_t>(w.panel)].load);
+    for (std::size_t e = 0; e < h.extent(0); ++e) scale = std::max(scale, std::abs(double(h(e))));
+  }
+  return scale;
+}
+
+void FsiCoupling::solveMembranes(double t1, double dt) {
   // On several ranks each membrane is solved by the rank that owns its faces, the ranks' membranes
   // at the same time; then every owner sends its answer to the others. The walls of a region
   // bounded by several membranes solve again on their moved shares until their multipliers agree
@@ -776,18 +1021,6 @@ void FsiCoupling::solveStructure(double t1, double dt) {
     }
     if (!again) break;
   }
-  for (Panel& p : panels_) {
-    const MembraneSolveReport& rep = p.report;
-    if (!rep.converged || !std::isfinite(rep.relativeResidual)) {
-      std::ostringstream os;
-      os << p.module->name() << ": the structure solve did not converge in the step to t = " << t1 << " ("
-         << (last_.iterations == 0 ? std::string("the predictor on the loads of t_n")
-                                   : "coupling iteration " + std::to_string(last_.iterations))
-         << "; " << rep.iterations << " Newton iterations, relative residual " << rep.relativeResidual << ")";
-      throw DivergenceError(os.str());
-    }
-  }
-  ++last_.structureSolves;
 }
 
 void FsiCoupling::shareSolve(Panel& p, double t1, double dt) {
@@ -855,11 +1088,13 @@ void FsiCoupling::setTrial(InterfaceVector& x) {
   // acceleration's (the mode in which they trade volume through the fluid is where a strong added
   // mass lives), so only the total is corrected, the miss shared by the walls' compliances (a
   // uniform change of the region's pressure). The structure solve's shares are kept for its next solve.
+  // With moving walls the walls' total is what the bodies' places at x leave.
   std::vector<std::pair<MembraneVolumeConstraint*, real>> shares;
+  const Eigen::VectorXd q = bodyCoordinates(x);
   for (Chamber& c : chambers_) {
-    if (c.walls.size() < 2) continue;
+    if (c.walls.size() < 2 && !c.moving()) continue;
     std::vector<double> volume;
-    double miss = c.volumeStart + c.volumeStep, sumC = 0;
+    double miss = c.volumeStart + c.volumeStep - rigidVolumeAt(c, q), sumC = 0;
     for (const ChamberWall& w : c.walls) {
       Panel& p = panels_[static_cast<std::size_t>(w.panel)];
       copySegmentToDevice(x, p.offset, p.iterate);
@@ -870,7 +1105,7 @@ void FsiCoupling::setTrial(InterfaceVector& x) {
     for (std::size_t i = 0; i < c.walls.size(); ++i) {
       MembraneVolumeConstraint& vc = memberSolver(c.walls[i]).volumeConstraint();
       shares.emplace_back(&vc, vc.target);
-      vc.target = volume[i] + miss * vc.compliance / sumC;
+      vc.target = volume[i] + miss * (sumC > 0 ? vc.compliance / sumC : 1.0 / double(c.walls.size()));
     }
   }
   for (std::size_t i = 0; i < panels_.size(); ++i) {
@@ -939,19 +1174,24 @@ bool FsiCoupling::limitUpdate(InterfaceVector& x, const InterfaceVector& previou
   return limited;
 }
 
-void FsiCoupling::placeBodies(const InterfaceVector& x) {
-  if (bodies_.empty()) return;
+std::vector<RigidPlacement> FsiCoupling::placementsOf(const Eigen::VectorXd& q) const {
   const RigidBodySystem& sys = rigid_->system();
-  const Eigen::Index n = sys.nDof();
-  const Eigen::VectorXd q = x.segment(bodyOffset_, n), zero = Eigen::VectorXd::Zero(n);
+  const Eigen::VectorXd zero = Eigen::VectorXd::Zero(sys.nDof());
   RigidTreeKinematics kin;
   sys.model().kinematics(stepEnd_, q, zero, zero, kin);
+  std::vector<RigidPlacement> t(bodies_.size());
   for (std::size_t slot = 0; slot < bodies_.size(); ++slot) {
     const CoupledBody& b = bodies_[slot];
-    transforms_[slot] =
-        placementFromStart(b.com0, b.rotation0, kin.bodies[b.index].com, kin.bodies[b.index].frame.rotation);
-    b.motion.apply(exec_, transforms_[slot], smoother_->displacement());
+    t[slot] = placementFromStart(b.com0, b.rotation0, kin.bodies[b.index].com, kin.bodies[b.index].frame.rotation);
   }
+  return t;
+}
+
+void FsiCoupling::placeBodies(const InterfaceVector& x) {
+  if (bodies_.empty()) return;
+  transforms_ = placementsOf(x.segment(bodyOffset_, rigid_->system().nDof()));
+  for (std::size_t slot = 0; slot < bodies_.size(); ++slot)
+    bodies_[slot].motion.apply(exec_, transforms_[slot], smoother_->displacement());
   if (!reach_.blend.empty()) {
     for (std::size_t i = 0; i < reach_.slot.size(); ++i) reach_.transforms[i] = transforms_[reach_.slot[i]];
     reach_.blend.displacement(exec_, reach_.transforms, reach_.base);
@@ -1049,6 +1289,7 @@ void FsiCoupling::advance(const TimeState& t) {
   if (options_.extrapolatedPredictor) extrapolateLoads();
   InterfaceVector x(size_), xt(size_), good(size_);
   for (const Panel& p : panels_) copySegmentToHost(p.module->solver().displacement(), good, p.offset);  // the mesh is there
+  if (!bodies_.empty()) good.segment(bodyOffset_, rigid_->system().nDof()) = rigid_->system().q();  // the bodies too
   acceleration_->beginStep();
   const bool implicit = options_.scheme == CouplingScheme::Implicit;
   // The structure goes first, on the loads of t_n: its answer is the predictor x_1 (and the whole
@@ -1105,10 +1346,12 @@ void FsiCoupling::advance(const TimeState& t) {
   // Converged (or explicit): the structure's last answer is committed; the fluid saw the mesh at x,
   // within fsiTol of it. Not converged: the last relaxed iterate, which the mesh and fluid match.
   if (!last_.converged && implicit) setTrial(x);
+  const Eigen::VectorXd qGood = bodyCoordinates(good);
   for (Chamber& c : chambers_) {
     // The fluid mesh ends the step at `good` (the last iterate moved to): the next step's start.
     const double start = c.volumeStart;
-    c.volumeStart = 0;
+    c.rigidStart = c.rigidNow = rigidVolumeAt(c, qGood);
+    c.volumeStart = c.rigidStart;
     bool patches = true;  // every wall a membrane patch (none a baffle)
     double pa = 0, a = 0;  // the fluid's load on the walls, integrated, and their area
     for (ChamberWall& w : c.walls) {
@@ -1146,13 +1389,15 @@ void FsiCoupling::advance(const TimeState& t) {
     c.maxMissRun = std::max(c.maxMissRun, c.volumeMiss);
   }
   commitStructure();
-  for (const Chamber& c : chambers_) {
+  for (Chamber& c : chambers_) {
     if (c.lumped) continue;
     // The fluid's pressure level in the chamber takes over the multiplier: its field is then the
     // physical pressure, and the next step's multiplier is the change of the level over it (on
     // several walls, what each one's multiplier differs from the agreed one stays with it).
     const real lambda = c.lambda;
     fluid_->solver().shiftPressureLevel(c.fluidRegion, lambda);
+    c.bodyLambda -= lambda;
+    c.bodyLambdaStart = c.bodyLambda;  // the next step's start (its first body loads take it)
     for (const ChamberWall& w : c.walls) {
       Panel& p = panels_[static_cast<std::size_t>(w.panel)];
       MembraneSolver& s = p.module->solver();
@@ -1196,6 +1441,7 @@ std::vector<std::string> FsiCoupling::stepColumns() const {
       c.push_back(chamberName(k, name));
     if (chambers_[k].walls.size() > 1)  // the share rounds and the multipliers' last disagreement
       for (const char* name : {"chamberShareRounds", "chamberMultiplierSpread"}) c.push_back(chamberName(k, name));
+    if (chambers_[k].moving()) c.push_back(chamberName(k, "chamberSweeps"));  // the bodies' multiplier sweeps
   }
   return c;
 }
@@ -1207,6 +1453,7 @@ void FsiCoupling::appendStepValues(std::vector<double>& v) const {
   for (const Chamber& c : chambers_) {
     v.insert(v.end(), {c.volumeStep, c.volumeMiss, c.pressure});
     if (c.walls.size() > 1) v.insert(v.end(), {double(c.rounds), c.spread});
+    if (c.moving()) v.push_back(double(c.sweeps));
   }
 }
 
@@ -1236,6 +1483,7 @@ void FsiCoupling::addMetrics(std::map<std::string, double>& m) const {
     m[chamberName(k, "coupling.chamber_volume")] = c.volumeStart;
     m[chamberName(k, "coupling.chamber_pressure")] = c.pressure;
     if (c.walls.size() > 1) m[chamberName(k, "coupling.chamber_max_share_rounds")] = c.maxRoundsRun;
+    if (c.moving()) m[chamberName(k, "coupling.chamber_max_sweeps")] = c.maxSweepsRun;
   }
   const auto& all = timers_.all();
   auto seconds = [&](const char* k) {
@@ -1333,13 +1581,14 @@ void FsiCoupling::saveState(io::StateWriter& w) const {
     const Chamber& c = chambers_[k];
     const std::string key = k == 0 ? std::string("chamber") : "chamber" + std::to_string(k);
     w.put(key, std::vector<double>{c.volumeStart, c.sweptLast, c.maxMissRun, c.volumeStep, c.volumeMiss, c.pressure});
-    if (c.walls.size() < 2) continue;
-    // Several walls: each one's start volume and compliance (the next step's split).
+    if (c.moving()) w.put(key + "Rigid", std::vector<double>{c.rigidStart, c.bodyLambda});
+    if (c.walls.size() < 2 && !c.moving()) continue;
+    // Several or moving walls: each one's start volume and compliance (the next step's split).
     std::vector<double> walls;
     for (const ChamberWall& cw : c.walls)
       walls.insert(walls.end(), {cw.volumeStart, double(memberSolver(cw).volumeConstraint().compliance)});
     w.put(key + "Walls", walls);
-    w.put(key + "Rounds", std::vector<std::int64_t>{c.maxRoundsRun});
+    w.put(key + "Rounds", std::vector<std::int64_t>{c.maxRoundsRun, c.maxSweepsRun});
   }
 }
 
@@ -1399,17 +1648,24 @@ void FsiCoupling::loadState(const io::StateReader& r) {
     const auto ch = r.doubles(k == 0 ? std::string("chamber") : "chamber" + std::to_string(k), 6);
     double* to[6] = {&c.volumeStart, &c.sweptLast, &c.maxMissRun, &c.volumeStep, &c.volumeMiss, &c.pressure};
     for (int j = 0; j < 6; ++j) *to[j] = ch[static_cast<std::size_t>(j)];
-    if (c.walls.size() < 2) {
+    const std::string key = k == 0 ? std::string("chamber") : "chamber" + std::to_string(k);
+    if (c.moving()) {
+      const auto rigid = r.doubles(key + "Rigid", 2);
+      c.rigidStart = c.rigidNow = rigid[0];
+      c.bodyLambda = c.bodyLambdaStart = rigid[1];
+    }
+    if (c.walls.size() < 2 && !c.moving()) {
       c.walls[0].volumeStart = c.volumeStart;
       continue;
     }
-    const std::string key = k == 0 ? std::string("chamber") : "chamber" + std::to_string(k);
     const auto walls = r.doubles(key + "Walls", 2 * static_cast<long long>(c.walls.size()));
     for (std::size_t i = 0; i < c.walls.size(); ++i) {
       c.walls[i].volumeStart = walls[2 * i];
       memberSolver(c.walls[i]).volumeConstraint().compliance = walls[2 * i + 1];
     }
-    c.maxRoundsRun = static_cast<int>(r.ints(key + "Rounds", 1)[0]);
+    const auto rounds = r.ints(key + "Rounds", 2);
+    c.maxRoundsRun = static_cast<int>(rounds[0]);
+    c.maxSweepsRun = static_cast<int>(rounds[1]);
   }
 }
 

@@ -35,6 +35,10 @@
 /// bounded by several membranes shares one multiplier: each membrane solves with a share of the
 /// target, the shares move by compliance until the multipliers agree (Newton on the split), and a
 /// relaxed iterate is moved back onto the region's total only, keeping the acceleration's split.
+/// Bodies that bound a region or carry its membrane (mounted on one body) change its volume
+/// rigidly: the walls' targets follow the bodies' trial coordinates, and the bodies take the
+/// region's multiplier (weighted as the walls' integrator weighs it), which the structure solve
+/// iterates by secant until the walls return the multiplier the bodies were solved with.
 ///
 /// Membrane state never leaks from one iteration into the next: a dynamic membrane re-solves the
 /// step from its committed state (MembraneSolver::solveStep) and commits once; the fluid re-solves
@@ -50,6 +54,7 @@
 #include "coupling/motion/MeshSmoother.hpp"
 #include "coupling/orchestrator/CouplingConfig.hpp"
 
+#include <algorithm>
 #include <memory>
 #include <vector>
 
@@ -150,6 +155,10 @@ class FsiCoupling final : public Module {
     coupling::BodyPatchMotion motion;
     Eigen::Vector3d com0 = Eigen::Vector3d::Zero();      ///< centre of mass at the start (the mesh's configuration)
     Eigen::Matrix3d rotation0 = Eigen::Matrix3d::Identity();
+    /// The load of updateBodyLoads (fluid, mounted membranes) and the point its moment is about;
+    /// applyBodyLoads adds the chambers' multipliers.
+    Eigen::Vector3d loadCentre = Eigen::Vector3d::Zero(), loadForce = Eigen::Vector3d::Zero(),
+                    loadMoment = Eigen::Vector3d::Zero();
   };
   /// Membrane loads from the fluid (times `scale`); with `relax`, forceOmega-blended with the
   /// previous ones. Sets the load residual. `stepStart`: the loads of t_n, before the step's first
@@ -160,12 +169,18 @@ class FsiCoupling final : public Module {
   /// The fluid's force and moment on each coupled body's patches (times `scale`) and its mounted
   /// membranes' loads and relative inertia become its external load.
   void updateBodyLoads(double scale, bool stepStart);
+  /// The bodies' external loads: updateBodyLoads's plus each chamber's bodyLambda on the bodies'
+  /// faces that bound it and on the mounted walls they carry.
+  void applyBodyLoads();
   /// Mounted dynamic membranes: the inertial force of their mass carried by the bodies' current
   /// accelerations (Panel::inertia), and the FEM's nodal load in the frames (viscous + inertia).
   /// extrapolatedPredictor: each panel's load becomes 2 p_n - p_n-1 (p_n kept for the next step).
   void extrapolateLoads();
   void updateFrameInertia();
   void solveStructure(double t1, double dt);
+  /// Every membrane solves the step once (on several ranks: its owner, then shareSolve), the walls
+  /// of a chamber with several again on moved shares until their multipliers agree.
+  void solveMembranes(double t1, double dt);
   /// Every rank but the panel's owner receives the owner's answer to the last solve (collective).
   void shareSolve(Panel& p, double t1, double dt);
   void gatherTrial(coupling::InterfaceVector& xt) const;
@@ -200,6 +215,8 @@ class FsiCoupling final : public Module {
   /// (fluidRegion: the fluid's closed region, -1 for the whole domain or a lumped chamber): their
   /// constraints are switched on at the volumes they have now.
   void addChamber(const std::vector<std::pair<int, real>>& walls, int fluidRegion, bool lumped);
+  /// The slot of a mounted panel's one parent body (every node's weight 1 for it), or -1.
+  int singleParent(const Panel& p) const;
   /// The chamber panel `panel` closes (one of its walls), or -1.
   int chamberOf(int panel) const;
   /// A chamber's column or metric name: `name` alone with one chamber, `name` + "." + its (first)
@@ -248,24 +265,66 @@ class FsiCoupling final : public Module {
   /// and the shares move until the multipliers agree (solveStructure).
   struct ChamberWall {
     int panel = -1;          ///< index into panels_
-    double volumeStart = 0;  ///< its share of the region's volume change at the step's start
+    double volumeStart = 0;  ///< its share of the region's volume change at the step's start (frame-relative)
+    int parent = -1;         ///< mounted: the coupled-body slot of its one parent body
+    RealView rigid;          ///< mounted: its nodes' displacement were they carried rigidly by the body
+    RealView pressure;       ///< mounted: its multiplier on every element (what its body receives of it)
+  };
+  /// A coupled body's faces that bound a chamber: as the body moves they change its volume, and
+  /// the chamber's pressure pushes on them.
+  struct ChamberBody {
+    int slot = -1;
+    std::vector<std::array<double, 12>> faces;  ///< this rank's (owned) faces: reference corners
+    Eigen::Vector3d area = Eigen::Vector3d::Zero();    ///< sum of their area vectors out of the fluid (all ranks)
+    Eigen::Vector3d moment = Eigen::Vector3d::Zero();  ///< sum of (centroid - start centre of mass) x area (all ranks)
   };
   struct Chamber {
     std::vector<ChamberWall> walls;
+    std::vector<ChamberBody> bodies;  ///< bodies that bound it (the parents of mounted walls among them)
     int fluidRegion = -1;      ///< the fluid's closed region (FluidSolver::addClosedRegion); -1: the whole domain
     bool lumped = false;       ///< an unmeshed gas chamber behind the membrane (coupling.lumpedChamber)
     double volumeStart = 0;    ///< the chamber's volume change where the fluid mesh is at the step's start
+    /// Moving walls (bodies, mounted membranes): the volume change the bodies' rigid motion makes
+    /// (mounted membranes carried undeformed), at the step's start and for the walls' current
+    /// targets. The walls' frame-relative volumes make up the rest.
+    double rigidStart = 0, rigidNow = 0;
     double sweptLast = 0;      ///< what the membranes swept in the last step (the BDF2 mesh flux reads it)
     double maxMissRun = 0;     ///< largest volume miss of the run [m^3]
     int maxRoundsRun = 0;      ///< most share rounds of one structure solve in the run
+    int maxSweepsRun = 0;      ///< most bodies' multiplier sweeps of one structure solve in the run
     // This step's:
     double volumeStep = 0;     ///< the target's change over the step [m^3]
     double volumeMiss = 0;     ///< largest |volume change - target| of its iterates [m^3]
     double pressure = 0;       ///< the chamber's pressure [Pa]
     double lambda = 0;         ///< the multiplier of the last structure solve (several walls: their agreed one)
+    /// Moving walls: the multiplier the bodies were last solved with (the structure solve iterates
+    /// it by secant until the walls' multiplier returns it).
+    double bodyLambda = 0, bodyLambdaStart = 0;  ///< ... and its value at the step's start
     double spread = 0;         ///< several walls: max |lambda_i - lambda| / the pressure scale, last solve
     int rounds = 0;            ///< several walls: most share rounds of one structure solve this step
+    int sweeps = 0;            ///< moving walls: most multiplier sweeps of one structure solve this step
+    /// Bodies bound it or carry one of its walls.
+    bool moving() const {
+      return !bodies.empty() ||
+             std::any_of(walls.begin(), walls.end(), [](const ChamberWall& w) { return w.parent >= 0; });
+    }
   };
+  /// The new chamber's moving walls: its mounted walls' parents, and every coupled body's faces
+  /// on the fluid region `region` (cellRegion: the region of each local cell).
+  void addMovingWalls(Chamber& c, const std::vector<int>& cellRegion, int region);
+  /// The bodies' rigid motions at coordinates q (the placements placeBodies applies).
+  std::vector<RigidPlacement> placementsOf(const Eigen::VectorXd& q) const;
+  /// A chamber's volume change by its bodies' rigid motions `t` (collective on several ranks).
+  double rigidVolume(Chamber& c, const std::vector<RigidPlacement>& t);
+  /// The chamber's bodies at coordinates q (empty: no bodies): rigidVolume, 0 without moving walls.
+  double rigidVolumeAt(Chamber& c, const Eigen::VectorXd& q);
+  /// x's block of the bodies' coordinates (empty without bodies).
+  Eigen::VectorXd bodyCoordinates(const coupling::InterfaceVector& x) const;
+  /// Chambers with moving walls: the walls' targets follow the bodies' trial coordinates (the
+  /// shares keep their split).
+  void followBodies();
+  /// The pressure a chamber's walls carry: the largest of their multipliers and element loads.
+  double pressureScale(const Chamber& c) const;
   /// Several walls: the volume target's split into the membranes' shares at the step's start (by
   /// their last compliances; by area before the first solve).
   void splitTarget(Chamber& c);

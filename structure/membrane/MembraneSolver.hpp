@@ -127,6 +127,9 @@ class MembraneSolver {
   /// The volume constraint of `solveStep` (inactive by default). Static solves refuse an active one.
   MembraneVolumeConstraint& volumeConstraint() { return volume_; }
   const MembraneVolumeConstraint& volumeConstraint() const { return volume_; }
+  /// The weight of the loads of the step's start in its equilibrium: generalized-alpha's alpha_f
+  /// (0 with Newmark). A body that shares the multiplier takes it weighted alike.
+  real startLoadWeight() const { return integrator().af; }
   /// sign * (the volume the membrane swept from its reference to u): the constrained region's
   /// volume change at displacement u.
   real enclosedVolume(const ConstRealView& u);
