@@ -196,7 +196,12 @@ void FsiCoupling::setUpLumpedChamber(const SceneConfig& section) {
                                           "membrane patch (mesh: {boundaryPatch: ...})");
   if (!p.dynamic)
     throw InputError(where, lc.membrane + ": a lumped chamber's volume constraint needs the dynamic analysis");
-  if (p.mounted) throw InputError(where, lc.membrane + ": a lumped chamber behind a mounted membrane is not supported yet");
+  // Behind a mounted membrane the chamber is taken to ride with its body (enclosed by the body and
+  // the membrane): its volume is the membrane's frame-relative one, and its pressure on the body's
+  // own walls cancels what the membrane would pass on, so the body takes none of it.
+  if (p.mounted && singleParent(p) < 0)
+    throw InputError(where, lc.membrane + " is blended between several bodies (parentBodyPatches): a lumped "
+                                          "chamber rides with one body; mount the membrane on one");
   // The chamber lies on the side the element normals (out of the fluid) point into.
   addChamber({{i, real(-1)}}, -1, true);
 }
