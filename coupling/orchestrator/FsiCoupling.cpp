@@ -285,10 +285,7 @@ void FsiCoupling::addMovingWalls(Chamber& c, const std::vector<int>& cellRegion,
     b.moment = Eigen::Vector3d(sums[3], sums[4], sums[5]);
     c.bodies.push_back(std::move(b));
   }
-  if (!c.moving()) return;
-  // The volume change at the start (zero: the bodies and walls at their reference places), the
-  // walls' frame-relative ones added.
-  c.rigidStart = c.rigidNow = 0;
+  // rigidStart stays 0: the bodies start at their reference places.
 }
 
 int FsiCoupling::chamberOf(int panel) const {
@@ -1401,8 +1398,10 @@ void FsiCoupling::advance(const TimeState& t) {
     // several walls, what each one's multiplier differs from the agreed one stays with it).
     const real lambda = c.lambda;
     fluid_->solver().shiftPressureLevel(c.fluidRegion, lambda);
-    c.bodyLambda -= lambda;
-    c.bodyLambdaStart = c.bodyLambda;  // the next step's start (its first body loads take it)
+    if (c.moving()) {
+      c.bodyLambda -= lambda;
+      c.bodyLambdaStart = c.bodyLambda;  // the next step's start (its first body loads take it)
+    }
     for (const ChamberWall& w : c.walls) {
       Panel& p = panels_[static_cast<std::size_t>(w.panel)];
       MembraneSolver& s = p.module->solver();

@@ -20,7 +20,8 @@
 # - One region bounded by two membranes (their shared multiplier), each solved by its own rank:
 #   the same as one rank's (deflections 1e-8, volume 1e-10, pressure 2e-6).
 # - A chamber under a sprung lid that carries its membrane: the same as one rank's (the lid's rise
-#   and the deflection 1e-8, the volume 1e-10, the pressure 1e-7).
+#   and the deflection 1e-8, the volume 1e-10, the pressure 1e-7); a lumped gas chamber riding in
+#   the lid likewise.
 # - Two screens far apart: each solved by its own rank only (one per rank), the answer sent to
 #   the other: the same as one rank's to 1e-9.
 # - `mfsi partition` writes the map a run computes: the cavity run on 2 ranks with --partition
@@ -234,6 +235,11 @@ run_pair(lid ${DATA}/balloon_on_lid.yaml)
 same(lid1 lid2 1e-8 bodies.body.lid.displacement membrane.top.centreUy)
 same(lid1 lid2 1e-10 coupling.chamber_volume)
 same(lid1 lid2 1e-7 coupling.chamber_pressure)
+# The lumped gas chamber riding in the lid (tests/data/balloon_lumped_on_lid.yaml): the lid's rise
+# and the deflection to 1e-8, the gas pressure to 1e-7.
+run_pair(lumped_lid ${DATA}/balloon_lumped_on_lid.yaml)
+same(lumped_lid1 lumped_lid2 1e-8 bodies.body.lid.displacement membrane.top.centreUy)
+same(lumped_lid1 lumped_lid2 1e-7 coupling.chamber_pressure)
 
 # The VAD pump with both chambers meshed (cases/vad-two-chambers.yaml: the air closed by the
 # membrane's volume constraint, the mesh moved by 482 columns on both sides of the membrane, which
