@@ -445,10 +445,7 @@ bool FsiCoupling::moveShares(Chamber& c, bool resolved) {
   c.spread = scale > 0 ? spread / scale : 0.0;
   // Shares moved by less than the membranes' volume tolerance move nothing (no wall took a Newton
   // iteration): the multipliers agree as well as the membrane solves can tell.
-  bool moved = !resolved;
-  for (const ChamberWall& w : c.walls)
-    moved = moved || panels_[static_cast<std::size_t>(w.panel)].report.iterations > 0;
-  if (!moved) return true;
+  if (resolved && !wallsIterated(c)) return true;
   if (spread <= kShareAgreement * options_.fsiTol * scale) return true;
   for (const ChamberWall& w : c.walls) {
     MembraneVolumeConstraint& vc = memberSolver(w).volumeConstraint();
@@ -935,10 +932,9 @@ void FsiCoupling::solveStructure(double t1, double dt) {
       if (!c.moving()) continue;
       const double lambda = c.walls.size() > 1 ? c.lambda : double(memberSolver(c.walls[0]).volumeConstraint().lambda);
       const double miss = lambda - c.bodyLambda;
-      bool moved = sweep == 0;  // a sweep whose walls took no Newton iteration can tell no more
-      for (const ChamberWall& w : c.walls)
-        moved = moved || panels_[static_cast<std::size_t>(w.panel)].report.iterations > 0;
-      if (!moved || std::abs(miss) <= kShareAgreement * options_.fsiTol * pressureScale(c)) continue;
+      // A sweep whose walls took no Newton iteration can tell no more.
+      if ((sweep > 0 && !wallsIterated(c)) || std::abs(miss) <= kShareAgreement * options_.fsiTol * pressureScale(c))
+        continue;
       if (sweep >= kMaxShareRounds) {
         std::ostringstream os;
         os << "coupling: the bodies and the membranes of a chamber ("
@@ -972,6 +968,12 @@ void FsiCoupling::solveStructure(double t1, double dt) {
     }
   }
   ++last_.structureSolves;
+}
+
+bool FsiCoupling::wallsIterated(const Chamber& c) const {
+  return std::any_of(c.walls.begin(), c.walls.end(), [&](const ChamberWall& w) {
+    return panels_[static_cast<std::size_t>(w.panel)].report.iterations > 0;
+  });
 }
 
 double FsiCoupling::pressureScale(const Chamber& c) const {

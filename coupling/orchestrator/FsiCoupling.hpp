@@ -325,6 +325,9 @@ class FsiCoupling final : public Module {
   void followBodies();
   /// The pressure a chamber's walls carry: the largest of their multipliers and element loads.
   double pressureScale(const Chamber& c) const;
+  /// Some wall of the chamber took a Newton iteration in its last solve (else its target moved by
+  /// less than its volume tolerance resolves).
+  bool wallsIterated(const Chamber& c) const;
   /// Several walls: the volume target's split into the membranes' shares at the step's start (by
   /// their last compliances; by area before the first solve).
   void splitTarget(Chamber& c);
