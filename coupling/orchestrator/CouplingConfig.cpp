@@ -178,7 +178,8 @@ Schema couplingSchema() {
                            "chamber), the membrane patch that closes it solves each step with a volume constraint: "
                            "one multiplier, a uniform pressure, makes its swept volume equal the inflow, so the fluid "
                            "always has a consistent answer (a region bounded by several membranes shares one "
-                           "multiplier among them; coupled bodies that bound it or carry its membrane take it too); "
+                           "multiplier among them; a membrane between two closed regions carries the difference of "
+                           "theirs; coupled bodies that bound it or carry its membrane take it too); "
                            "false: plain Dirichlet-Neumann coupling"),
            Default(o.volumeConstraint))
       .key("viscousTraction",

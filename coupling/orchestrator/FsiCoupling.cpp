@@ -131,6 +131,7 @@ FsiCoupling::FsiCoupling(const CouplingOptions& options, const SceneConfig& sect
   setUpBodies(section, layout);
   setUpParents(section);
   setUpChamber(section);
+  groupChambers(section.where(options_.lumpedChamber.membrane.empty() ? "volumeConstraint" : "lumpedChamber"));
   smoother_ = std::make_unique<coupling::MeshSmoother>(mesh_, options_.motion, domain_);
   if (!options_.bodyReach.empty()) {
     std::vector<coupling::RigidBlend::Body> reach;
@@ -213,13 +214,18 @@ void FsiCoupling::addChamber(const std::vector<std::pair<int, real>>& walls, int
   for (const auto& [panel, sign] : walls) {
     MembraneSolver& s = panels_[static_cast<std::size_t>(panel)].module->solver();
     MembraneVolumeConstraint& vc = s.volumeConstraint();
-    vc.active = true;
-    vc.sign = sign;
-    vc.lambda = 0;
     ChamberWall w;
     w.panel = panel;
-    w.volumeStart = s.enclosedVolume(s.displacement());
-    vc.target = w.volumeStart;
+    if (chamberOf(panel) >= 0) {
+      // The membrane's other side closes an earlier chamber: its constraint keeps that one's sign.
+      w.sign = sign * vc.sign;
+    } else {
+      vc.active = true;
+      vc.sign = sign;
+      vc.lambda = 0;
+      vc.target = s.enclosedVolume(s.displacement());
+    }
+    w.volumeStart = w.sign * s.enclosedVolume(s.displacement());
     c.volumeStart += w.volumeStart;
     c.walls.push_back(w);
   }
@@ -297,7 +303,22 @@ int FsiCoupling::chamberOf(int panel) const {
 
 std::string FsiCoupling::chamberName(std::size_t chamber, const std::string& name) const {
   if (chambers_.size() == 1) return name;
-  return name + "." + membraneNames()[static_cast<std::size_t>(chambers_[chamber].walls.front().panel)];
+  // A membrane between two chambers names the first; the other is named by another of its walls,
+  // or, with none left, by the shared one and its number.
+  std::vector<int> used;
+  const std::vector<std::string> names = membraneNames();
+  for (std::size_t k = 0; k <= chamber; ++k) {
+    const std::vector<ChamberWall>& walls = chambers_[k].walls;
+    const auto free = std::find_if(walls.begin(), walls.end(), [&](const ChamberWall& w) {
+      return std::find(used.begin(), used.end(), w.panel) == used.end();
+    });
+    if (k == chamber)
+      return name + "." +
+             (free != walls.end() ? names[static_cast<std::size_t>(free->panel)]
+                                  : names[static_cast<std::size_t>(walls[0].panel)] + "." + std::to_string(k));
+    if (free != walls.end()) used.push_back(free->panel);
+  }
+  return name;
 }
 
 void FsiCoupling::setUpChamber(const SceneConfig& section) {
@@ -360,11 +381,8 @@ void FsiCoupling::setUpChamber(const SceneConfig& section) {
         throw InputError(where, p.module->name() + " closes a fluid region on several moving bodies "
                                 "(parentBodyPatches of two bodies): a volume constraint for a membrane blended "
                                 "between bodies is not supported; mount it on one body");
-      if (const int k = chamberOf(static_cast<int>(i)); k >= 0) {
-        const std::string other = chambers_[static_cast<std::size_t>(k)].lumped ? "a lumped one" : "a fluid region";
-        throw InputError(where, p.module->name() + " closes two chambers (" + other + " and a fluid region): one "
-                                "volume constraint per membrane; give one of them a pressure boundary");
-      }
+      // A membrane that closes a chamber on its other side too (a fluid region or a lumped one)
+      // carries both chambers' multipliers (groupChambers).
       // The membrane's element normals are the fluid faces' area vectors (the master side's on a
       // baffle; coupling/interface/MembraneInterface).
       walls.emplace_back(static_cast<int>(i), front ? real(1) : real(-1));
@@ -404,52 +422,142 @@ void FsiCoupling::beginChamberStep() {
     c.sweeps = 0;
     c.spread = 0;
     c.rigidNow = c.rigidStart;  // the bodies at the step's start: followBodies moves the targets on
-    splitTarget(c);
+  }
+  for (const ChamberGroup& g : groups_) splitTarget(g);
+}
+
+void FsiCoupling::groupChambers(const SourceLocation& where) {
+  // Chambers joined by a shared wall, found by flooding over the walls' panels.
+  std::vector<int> groupOf(chambers_.size(), -1);
+  for (std::size_t k = 0; k < chambers_.size(); ++k) {
+    if (groupOf[k] >= 0) continue;
+    ChamberGroup g;
+    std::vector<int> todo{static_cast<int>(k)};
+    groupOf[k] = static_cast<int>(groups_.size());
+    while (!todo.empty()) {
+      const int c = todo.back();
+      todo.pop_back();
+      g.chambers.push_back(c);
+      for (const ChamberWall& w : chambers_[static_cast<std::size_t>(c)].walls) {
+        if (std::find(g.panels.begin(), g.panels.end(), w.panel) == g.panels.end()) g.panels.push_back(w.panel);
+        for (std::size_t o = 0; o < chambers_.size(); ++o)
+          if (groupOf[o] < 0 && std::any_of(chambers_[o].walls.begin(), chambers_[o].walls.end(),
+                                            [&](const ChamberWall& x) { return x.panel == w.panel; })) {
+            groupOf[o] = groupOf[k];
+            todo.push_back(static_cast<int>(o));
+          }
+      }
+    }
+    std::sort(g.chambers.begin(), g.chambers.end());
+    for (int c : g.chambers) chambers_[static_cast<std::size_t>(c)].group = static_cast<int>(groups_.size());
+    g.incidence = Eigen::MatrixXd::Zero(static_cast<Eigen::Index>(g.chambers.size()),
+                                        static_cast<Eigen::Index>(g.panels.size()));
+    for (std::size_t r = 0; r < g.chambers.size(); ++r)
+      for (const ChamberWall& w : chambers_[static_cast<std::size_t>(g.chambers[r])].walls) {
+        const auto j = std::find(g.panels.begin(), g.panels.end(), w.panel) - g.panels.begin();
+        g.incidence(static_cast<Eigen::Index>(r), j) = w.sign;
+      }
+    if (g.chambers.size() > 1) {
+      std::string names;
+      for (int c : g.chambers) {
+        const Chamber& ch = chambers_[static_cast<std::size_t>(c)];
+        std::string walls;
+        for (const ChamberWall& w : ch.walls)
+          walls += (walls.empty() ? "" : " and ") + panels_[static_cast<std::size_t>(w.panel)].module->name();
+        names += (names.empty() ? "" : ", ") + std::string(ch.lumped ? "the lumped chamber" : "the fluid region") +
+                 " of " + walls;
+        if (ch.moving())
+          throw InputError(where, "closed chambers that share a membrane cannot have moving walls (bodies, or "
+                                  "membranes mounted on them): " + names);
+      }
+      // Full row rank: some wall leads out of every subset of the chambers (else their inflows
+      // would have to cancel, and only the difference of their pressures would be fixed).
+      const Eigen::FullPivLU<Eigen::MatrixXd> lu(g.incidence);
+      if (lu.rank() < g.incidence.rows())
+        throw InputError(where, "closed chambers (" + names + ") are bounded only by the membranes between them: "
+                                "their inflows would fix the membranes' volumes twice and their pressures only "
+                                "up to a common level; give one of them a pressure boundary");
+    }
+    groups_.push_back(std::move(g));
   }
 }
 
-void FsiCoupling::splitTarget(Chamber& c) {
-  // Weights: the walls' compliances (their volume's response to the multiplier; the walls then
-  // start at about one multiplier), or before any solve their areas.
-  std::vector<double> weight;
-  double sum = 0;
+Eigen::VectorXd FsiCoupling::wallWeights(const ChamberGroup& g) const {
+  Eigen::VectorXd w(static_cast<Eigen::Index>(g.panels.size()));
   bool compliant = true;
-  for (const ChamberWall& w : c.walls) compliant = compliant && memberSolver(w).volumeConstraint().compliance > 0;
-  for (const ChamberWall& w : c.walls) {
-    MembraneSolver& s = memberSolver(w);
-    weight.push_back(compliant ? double(s.volumeConstraint().compliance) : double(s.mesh().referenceArea()));
-    sum += weight.back();
+  for (int p : g.panels)
+    compliant = compliant && panels_[static_cast<std::size_t>(p)].module->solver().volumeConstraint().compliance > 0;
+  for (std::size_t j = 0; j < g.panels.size(); ++j) {
+    const MembraneSolver& s = panels_[static_cast<std::size_t>(g.panels[j])].module->solver();
+    w[static_cast<Eigen::Index>(j)] =
+        compliant ? double(s.volumeConstraint().compliance) : double(s.mesh().referenceArea());
   }
-  for (std::size_t i = 0; i < c.walls.size(); ++i)
-    memberSolver(c.walls[i]).volumeConstraint().target = c.walls[i].volumeStart + c.volumeStep * weight[i] / sum;
+  return w;
 }
 
-bool FsiCoupling::moveShares(Chamber& c, bool resolved) {
-  double sumC = 0, sumCl = 0;
-  for (const ChamberWall& w : c.walls) {
-    const MembraneVolumeConstraint& vc = memberSolver(w).volumeConstraint();
+Eigen::VectorXd FsiCoupling::shareOut(const ChamberGroup& g, const Eigen::VectorXd& weight,
+                                      const Eigen::VectorXd& d) const {
+  // One chamber: its walls' signs are +1 (a membrane shared with another chamber joins them).
+  if (g.chambers.size() == 1) return weight.size() == 1 ? d : Eigen::VectorXd(weight * (d[0] / weight.sum()));
+  const Eigen::MatrixXd& E = g.incidence;
+  const Eigen::VectorXd y = (E * weight.asDiagonal() * E.transpose()).ldlt().solve(d);
+  return weight.cwiseProduct(E.transpose() * y);
+}
+
+void FsiCoupling::splitTarget(const ChamberGroup& g) {
+  Eigen::VectorXd d(static_cast<Eigen::Index>(g.chambers.size()));
+  for (std::size_t r = 0; r < g.chambers.size(); ++r)
+    d[static_cast<Eigen::Index>(r)] = chambers_[static_cast<std::size_t>(g.chambers[r])].volumeStep;
+  const Eigen::VectorXd share = shareOut(g, wallWeights(g), d);
+  // Each wall from its start volume (in its constraint's sign).
+  std::vector<char> done(g.panels.size(), 0);
+  for (int c : g.chambers)
+    for (const ChamberWall& w : chambers_[static_cast<std::size_t>(c)].walls) {
+      const auto j = static_cast<std::size_t>(std::find(g.panels.begin(), g.panels.end(), w.panel) - g.panels.begin());
+      if (done[j]) continue;
+      done[j] = 1;
+      memberSolver(w).volumeConstraint().target = w.sign * w.volumeStart + share[static_cast<Eigen::Index>(j)];
+    }
+}
+
+bool FsiCoupling::moveShares(const ChamberGroup& g, bool resolved) {
+  const auto n = static_cast<Eigen::Index>(g.panels.size());
+  Eigen::VectorXd C(n), lambda(n);
+  for (Eigen::Index j = 0; j < n; ++j) {
+    const Panel& p = panels_[static_cast<std::size_t>(g.panels[static_cast<std::size_t>(j)])];
+    const MembraneVolumeConstraint& vc = p.module->solver().volumeConstraint();
     if (!(vc.compliance > 0))
-      throw DivergenceError(panels_[static_cast<std::size_t>(w.panel)].module->name() +
-                            ": its volume does not respond to the chamber's pressure (no free node moves it), so "
-                            "the chamber's volume cannot be shared among its membranes");
-    sumC += vc.compliance;
-    sumCl += vc.compliance * vc.lambda;
+      throw DivergenceError(p.module->name() + ": its volume does not respond to the chamber's pressure (no free node "
+                            "moves it), so the chamber's volume cannot be shared among its membranes");
+    C[j] = vc.compliance;
+    lambda[j] = vc.lambda;
   }
+  // The chambers' multipliers: one chamber, the compliance-weighted mean of its walls'.
+  const Eigen::MatrixXd& E = g.incidence;
+  const Eigen::VectorXd Lambda =
+      g.chambers.size() == 1
+          ? Eigen::VectorXd::Constant(1, C.dot(lambda) / C.sum())
+          : Eigen::VectorXd((E * C.asDiagonal() * E.transpose()).ldlt().solve(E * C.cwiseProduct(lambda)));
+  const Eigen::VectorXd agreed = E.transpose() * Lambda;  // what each wall should carry
   // The pressure the walls carry: the multipliers and the fluid's loads.
-  const double scale = pressureScale(c);
-  const double lambda = sumCl / sumC;
-  double spread = 0;
-  for (const ChamberWall& w : c.walls)
-    spread = std::max(spread, std::abs(memberSolver(w).volumeConstraint().lambda - lambda));
-  c.lambda = lambda;
-  c.spread = scale > 0 ? spread / scale : 0.0;
+  double scale = 0;
+  for (int c : g.chambers) scale = std::max(scale, pressureScale(chambers_[static_cast<std::size_t>(c)]));
+  const double spread = (lambda - agreed).cwiseAbs().maxCoeff();
+  for (std::size_t r = 0; r < g.chambers.size(); ++r) {
+    Chamber& c = chambers_[static_cast<std::size_t>(g.chambers[r])];
+    c.lambda = Lambda[static_cast<Eigen::Index>(r)];
+    c.spread = scale > 0 ? spread / scale : 0.0;
+  }
   // Shares moved by less than the membranes' volume tolerance move nothing (no wall took a Newton
   // iteration): the multipliers agree as well as the membrane solves can tell.
-  if (resolved && !wallsIterated(c)) return true;
+  if (resolved && std::none_of(g.chambers.begin(), g.chambers.end(), [&](int c) {
+        return wallsIterated(chambers_[static_cast<std::size_t>(c)]);
+      }))
+    return true;
   if (spread <= kShareAgreement * options_.fsiTol * scale) return true;
-  for (const ChamberWall& w : c.walls) {
-    MembraneVolumeConstraint& vc = memberSolver(w).volumeConstraint();
-    vc.target += vc.compliance * (lambda - vc.lambda);
+  for (Eigen::Index j = 0; j < n; ++j) {
+    MembraneSolver& s = panels_[static_cast<std::size_t>(g.panels[static_cast<std::size_t>(j)])].module->solver();
+    s.volumeConstraint().target += C[j] * (agreed[j] - lambda[j]);
   }
   return false;
 }
@@ -462,7 +570,7 @@ void FsiCoupling::checkChamberVolume(const InterfaceVector& x) {
       Panel& p = panels_[static_cast<std::size_t>(w.panel)];
       MembraneSolver& s = p.module->solver();
       copySegmentToDevice(x, p.offset, p.iterate);
-      volume += s.enclosedVolume(p.iterate);
+      volume += w.sign * s.enclosedVolume(p.iterate);
     }
     c.volumeMiss = std::max(c.volumeMiss, std::abs(volume - (c.volumeStart + c.volumeStep)));
   }
@@ -516,17 +624,16 @@ Eigen::VectorXd FsiCoupling::bodyCoordinates(const InterfaceVector& x) const {
 void FsiCoupling::followBodies() {
   if (bodies_.empty()) return;
   const Eigen::VectorXd q = rigid_->system().q();
-  for (Chamber& c : chambers_) {
+  for (const ChamberGroup& g : groups_) {
+    Chamber& c = chambers_[static_cast<std::size_t>(g.chambers[0])];  // moving walls: a group of one chamber
     const double r = rigidVolumeAt(c, q), d = r - c.rigidNow;
     if (d == 0) continue;
     c.rigidNow = r;
-    // The walls' total follows; its split stays (by compliance, by area before any solve).
-    double sum = 0;
-    for (const ChamberWall& w : c.walls) sum += memberSolver(w).volumeConstraint().compliance;
-    for (const ChamberWall& w : c.walls) {
-      MembraneVolumeConstraint& vc = memberSolver(w).volumeConstraint();
-      vc.target -= d * (sum > 0 ? vc.compliance / sum : 1.0 / double(c.walls.size()));
-    }
+    // The walls' total follows; its split stays.
+    const Eigen::VectorXd share = shareOut(g, wallWeights(g), Eigen::VectorXd::Constant(1, -d));
+    for (std::size_t j = 0; j < g.panels.size(); ++j)
+      panels_[static_cast<std::size_t>(g.panels[j])].module->solver().volumeConstraint().target +=
+          share[static_cast<Eigen::Index>(j)];
   }
 }
 
@@ -1004,23 +1111,25 @@ void FsiCoupling::solveMembranes(double t1, double dt) {
     const std::vector<char> solved = solve;
     std::fill(solve.begin(), solve.end(), char(0));
     bool again = false;
-    for (Chamber& c : chambers_) {
-      if (c.walls.size() < 2 || !solved[static_cast<std::size_t>(c.walls[0].panel)]) continue;
-      c.rounds = std::max(c.rounds, round);
-      c.maxRoundsRun = std::max(c.maxRoundsRun, round);
+    for (const ChamberGroup& g : groups_) {
+      if (g.panels.size() < 2 || !solved[static_cast<std::size_t>(g.panels[0])]) continue;
       bool converged = true;  // a wall whose solve failed is reported below
-      for (const ChamberWall& w : c.walls)
-        converged = converged && panels_[static_cast<std::size_t>(w.panel)].report.converged;
-      if (!converged || moveShares(c, round > 1)) continue;
+      for (int p : g.panels) converged = converged && panels_[static_cast<std::size_t>(p)].report.converged;
+      for (int k : g.chambers) {
+        Chamber& c = chambers_[static_cast<std::size_t>(k)];
+        c.rounds = std::max(c.rounds, round);
+        c.maxRoundsRun = std::max(c.maxRoundsRun, round);
+      }
+      if (!converged || moveShares(g, round > 1)) continue;
       if (round >= kMaxShareRounds) {
         std::ostringstream os;
         os << "coupling: the membranes of a chamber ("
-           << panels_[static_cast<std::size_t>(c.walls[0].panel)].module->name() << ", ...) did not agree on its "
-           << "pressure in " << kMaxShareRounds << " share rounds of the step to t = " << t1
-           << " (multipliers " << c.spread << " of the pressure apart)";
+           << panels_[static_cast<std::size_t>(g.panels[0])].module->name() << ", ...) did not agree on its "
+           << "pressure in " << kMaxShareRounds << " share rounds of the step to t = " << t1 << " (multipliers "
+           << chambers_[static_cast<std::size_t>(g.chambers[0])].spread << " of the pressure apart)";
         throw DivergenceError(os.str());
       }
-      for (const ChamberWall& w : c.walls) solve[static_cast<std::size_t>(w.panel)] = 1;
+      for (int p : g.panels) solve[static_cast<std::size_t>(p)] = 1;
       again = true;
     }
     if (!again) break;
@@ -1095,21 +1204,25 @@ void FsiCoupling::setTrial(InterfaceVector& x) {
   // With moving walls the walls' total is what the bodies' places at x leave.
   std::vector<std::pair<MembraneVolumeConstraint*, real>> shares;
   const Eigen::VectorXd q = bodyCoordinates(x);
-  for (Chamber& c : chambers_) {
-    if (c.walls.size() < 2 && !c.moving()) continue;
-    std::vector<double> volume;
-    double miss = c.volumeStart + c.volumeStep - rigidVolumeAt(c, q), sumC = 0;
-    for (const ChamberWall& w : c.walls) {
-      Panel& p = panels_[static_cast<std::size_t>(w.panel)];
+  for (const ChamberGroup& g : groups_) {
+    if (g.panels.size() < 2 && !chambers_[static_cast<std::size_t>(g.chambers[0])].moving()) continue;
+    Eigen::VectorXd volume(static_cast<Eigen::Index>(g.panels.size()));
+    for (std::size_t j = 0; j < g.panels.size(); ++j) {
+      Panel& p = panels_[static_cast<std::size_t>(g.panels[j])];
       copySegmentToDevice(x, p.offset, p.iterate);
-      volume.push_back(p.module->solver().enclosedVolume(p.iterate));
-      miss -= volume.back();
-      sumC += memberSolver(w).volumeConstraint().compliance;
+      volume[static_cast<Eigen::Index>(j)] = p.module->solver().enclosedVolume(p.iterate);
     }
-    for (std::size_t i = 0; i < c.walls.size(); ++i) {
-      MembraneVolumeConstraint& vc = memberSolver(c.walls[i]).volumeConstraint();
+    Eigen::VectorXd miss(static_cast<Eigen::Index>(g.chambers.size()));
+    for (std::size_t r = 0; r < g.chambers.size(); ++r) {
+      Chamber& c = chambers_[static_cast<std::size_t>(g.chambers[r])];
+      miss[static_cast<Eigen::Index>(r)] = c.volumeStart + c.volumeStep - rigidVolumeAt(c, q);
+    }
+    miss -= g.incidence * volume;
+    const Eigen::VectorXd share = shareOut(g, wallWeights(g), miss);
+    for (std::size_t j = 0; j < g.panels.size(); ++j) {
+      MembraneVolumeConstraint& vc = panels_[static_cast<std::size_t>(g.panels[j])].module->solver().volumeConstraint();
       shares.emplace_back(&vc, vc.target);
-      vc.target = volume[i] + miss * (sumC > 0 ? vc.compliance / sumC : 1.0 / double(c.walls.size()));
+      vc.target = volume[static_cast<Eigen::Index>(j)] + share[static_cast<Eigen::Index>(j)];
     }
   }
   for (std::size_t i = 0; i < panels_.size(); ++i) {
@@ -1362,7 +1475,7 @@ void FsiCoupling::advance(const TimeState& t) {
       Panel& p = panels_[static_cast<std::size_t>(w.panel)];
       MembraneSolver& s = p.module->solver();
       copySegmentToDevice(good, p.offset, p.iterate);
-      w.volumeStart = s.enclosedVolume(p.iterate);
+      w.volumeStart = w.sign * s.enclosedVolume(p.iterate);
       c.volumeStart += w.volumeStart;
       patches = patches && p.iface.side == coupling::InterfaceSide::Patch;
       const std::vector<real>& areas = s.mesh().elementAreas();
@@ -1373,7 +1486,8 @@ void FsiCoupling::advance(const TimeState& t) {
       }
     }
     c.sweptLast = c.volumeStart - start;
-    if (c.walls.size() == 1) c.lambda = memberSolver(c.walls[0]).volumeConstraint().lambda;
+    if (groups_[static_cast<std::size_t>(c.group)].panels.size() == 1)
+      c.lambda = memberSolver(c.walls[0]).volumeConstraint().lambda;
     // A lumped chamber's pressure is the multiplier over the outside pressure its membrane's load
     // is taken against. Behind a baffle the load is the difference across it: the chamber's
     // pressure is the multiplier plus the fluid's mean over the chamber's cells. Behind patches:
@@ -1397,7 +1511,8 @@ void FsiCoupling::advance(const TimeState& t) {
     if (c.lumped) continue;
     // The fluid's pressure level in the chamber takes over the multiplier: its field is then the
     // physical pressure, and the next step's multiplier is the change of the level over it (on
-    // several walls, what each one's multiplier differs from the agreed one stays with it).
+    // several walls, what each one's multiplier differs from the agreed one stays with it; a
+    // membrane between two chambers carries the difference of theirs).
     const real lambda = c.lambda;
     fluid_->solver().shiftPressureLevel(c.fluidRegion, lambda);
     if (c.moving()) {
@@ -1407,8 +1522,8 @@ void FsiCoupling::advance(const TimeState& t) {
     for (const ChamberWall& w : c.walls) {
       Panel& p = panels_[static_cast<std::size_t>(w.panel)];
       MembraneSolver& s = p.module->solver();
-      const real shift = s.volumeConstraint().sign * lambda;
-      s.shiftMultiplier(-lambda);
+      const real shift = s.volumeConstraint().sign * w.sign * lambda;
+      s.shiftMultiplier(-w.sign * lambda);
       for (const RealView& v : {p.load, p.loadPrevious, p.filtered})
         if (v.extent(0) > 0) blas::shift(exec_, static_cast<lid_t>(v.extent(0)), shift, v);
     }

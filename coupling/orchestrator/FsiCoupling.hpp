@@ -219,8 +219,8 @@ class FsiCoupling final : public Module {
   int singleParent(const Panel& p) const;
   /// The chamber panel `panel` closes (one of its walls), or -1.
   int chamberOf(int panel) const;
-  /// A chamber's column or metric name: `name` alone with one chamber, `name` + "." + its (first)
-  /// membrane's name with several.
+  /// A chamber's column or metric name: `name` alone with one chamber, `name` + "." + the name of
+  /// its first membrane that names no earlier chamber, with several.
   std::string chamberName(std::size_t chamber, const std::string& name) const;
   /// The coupled membranes' names as the scene spells them ("<name>" of module "membrane.<name>").
   std::vector<std::string> membraneNames() const;
@@ -265,7 +265,11 @@ class FsiCoupling final : public Module {
   /// and the shares move until the multipliers agree (solveStructure).
   struct ChamberWall {
     int panel = -1;          ///< index into panels_
-    double volumeStart = 0;  ///< its share of the region's volume change at the step's start (frame-relative)
+    /// +1: the region grows with its membrane's constrained volume (the region the membrane's
+    /// MembraneVolumeConstraint::sign was set for); -1: a membrane between two closed regions, seen
+    /// from the second one, which it shrinks.
+    real sign = 1;
+    double volumeStart = 0;  ///< its share of the region's volume change at the step's start (frame-relative; x sign)
     int parent = -1;         ///< mounted: the coupled-body slot of its one parent body
     RealView rigid;          ///< mounted: its nodes' displacement were they carried rigidly by the body
     RealView pressure;       ///< mounted: its multiplier on every element (what its body receives of it)
@@ -283,6 +287,7 @@ class FsiCoupling final : public Module {
     std::vector<ChamberBody> bodies;  ///< bodies that bound it (the parents of mounted walls among them)
     int fluidRegion = -1;      ///< the fluid's closed region (FluidSolver::addClosedRegion); -1: the whole domain
     bool lumped = false;       ///< an unmeshed gas chamber behind the membrane (coupling.lumpedChamber)
+    int group = -1;            ///< its group in groups_ (the chambers it shares walls with)
     double volumeStart = 0;    ///< the chamber's volume change where the fluid mesh is at the step's start
     /// Moving walls (bodies, mounted membranes): the volume change the bodies' rigid motion makes
     /// (mounted membranes carried undeformed), at the step's start and for the walls' current
@@ -309,6 +314,23 @@ class FsiCoupling final : public Module {
              std::any_of(walls.begin(), walls.end(), [](const ChamberWall& w) { return w.parent >= 0; });
     }
   };
+  /// Chambers that share a wall (a membrane between two closed regions) and their walls'
+  /// panels: their multipliers are solved together. Most groups are one chamber.
+  struct ChamberGroup {
+    std::vector<int> chambers;  ///< indices into chambers_
+    std::vector<int> panels;    ///< every wall's panel once
+    Eigen::MatrixXd incidence;  ///< chambers x panels: each wall's sign in each chamber, 0 where it is none
+  };
+  /// Groups the chambers by their shared walls. Throws InputError (naming `where`) for a group whose
+  /// pressures its walls cannot fix: closed regions bounded only by membranes between them (their
+  /// inflows would fix one volume twice), or several chambers and a moving wall.
+  void groupChambers(const SourceLocation& where);
+  /// The walls' weights for sharing a volume: their compliances, or before every wall has one
+  /// their reference areas.
+  Eigen::VectorXd wallWeights(const ChamberGroup& g) const;
+  /// The volume change per wall (of `weight`-weighted least size) that changes the chambers'
+  /// volumes by d: W E^T (E W E^T)^-1 d, E the incidence.
+  Eigen::VectorXd shareOut(const ChamberGroup& g, const Eigen::VectorXd& weight, const Eigen::VectorXd& d) const;
   /// The new chamber's moving walls: its mounted walls' parents, and every coupled body's faces
   /// on the fluid region `region` (cellRegion: the region of each local cell).
   void addMovingWalls(Chamber& c, const std::vector<int>& cellRegion, int region);
@@ -328,19 +350,20 @@ class FsiCoupling final : public Module {
   /// Some wall of the chamber took a Newton iteration in its last solve (else its target moved by
   /// less than its volume tolerance resolves).
   bool wallsIterated(const Chamber& c) const;
-  /// Several walls: the volume target's split into the membranes' shares at the step's start (by
-  /// their last compliances; by area before the first solve).
-  void splitTarget(Chamber& c);
-  /// Several walls, after every wall solved on its share: the compliance-weighted multiplier, and
-  /// each share moved by C_i (lambda - lambda_i) (the shares keep their sum). Returns true when
-  /// the multipliers agreed to kShareAgreement x fsiTol before the move (nothing moved then), or
-  /// when `resolved` (a solve on moved shares) and no wall took a Newton iteration.
-  bool moveShares(Chamber& c, bool resolved);
+  /// The volume targets' split into the walls' shares at the step's start (wallWeights).
+  void splitTarget(const ChamberGroup& g);
+  /// Several walls, after every wall solved on its share: the chambers' multipliers Lambda that
+  /// the walls' multipliers agree with best (E C E^T Lambda = E C lambda, C the compliances), and
+  /// each share moved by C_i ((E^T Lambda)_i - lambda_i) (the chambers' volumes stay). Returns
+  /// true when the multipliers agreed to kShareAgreement x fsiTol before the move (nothing moved
+  /// then), or when `resolved` (a solve on moved shares) and no wall took a Newton iteration.
+  bool moveShares(const ChamberGroup& g, bool resolved);
   /// A wall's membrane solver (the panels hold their modules by pointer).
   MembraneSolver& memberSolver(const ChamberWall& w) const {
     return panels_[static_cast<std::size_t>(w.panel)].module->solver();
   }
   std::vector<Chamber> chambers_;
+  std::vector<ChamberGroup> groups_;
 };
 
 /// Catalogue entry of the `coupling` section (needs the `fluid` section and at least one membrane

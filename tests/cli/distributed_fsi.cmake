@@ -22,6 +22,8 @@
 # - A chamber under a sprung lid that carries its membrane: the same as one rank's (the lid's rise
 #   and the deflection 1e-8, the volume 1e-10, the pressure 1e-7); a lumped gas chamber riding in
 #   the lid likewise.
+# - A membrane between two closed regions, each membrane on its own rank: the same as one rank's
+#   (deflections 1e-8, volumes 1e-10, pressures 1e-6).
 # - Two screens far apart: each solved by its own rank only (one per rank), the answer sent to
 #   the other: the same as one rank's to 1e-9.
 # - `mfsi partition` writes the map a run computes: the cavity run on 2 ranks with --partition
@@ -220,12 +222,16 @@ run_pair(shared ${DATA}/balloon_shared.yaml)
 same(shared1 shared2 1e-8 membrane.topA.centreUy membrane.topB.centreUy)
 same(shared1 shared2 1e-10 coupling.chamber_volume)
 same(shared1 shared2 2e-6 coupling.chamber_pressure)
-file(READ ${WORK}/shared2/summary.json js)
-string(JSON a GET "${js}" metrics coupling.membrane.topA.solved_on_rank)
-string(JSON b GET "${js}" metrics coupling.membrane.topB.solved_on_rank)
-if(a EQUAL b OR a LESS 0 OR b LESS 0)
-  message(SEND_ERROR "the shared region on 2 ranks: its membranes solved on ranks ${a} and ${b} (want one each)")
-endif()
+# one_each(<run> <membrane> <membrane>): on 2 ranks each of the two membranes is solved by its own rank.
+function(one_each name first second)
+  file(READ ${WORK}/${name}/summary.json js)
+  string(JSON a GET "${js}" metrics coupling.membrane.${first}.solved_on_rank)
+  string(JSON b GET "${js}" metrics coupling.membrane.${second}.solved_on_rank)
+  if(a EQUAL b OR a LESS 0 OR b LESS 0)
+    message(SEND_ERROR "${name}: its membranes solved on ranks ${a} and ${b} (want one each)")
+  endif()
+endfunction()
+one_each(shared2 topA topB)
 
 # A closed chamber under a sprung lid that carries its membrane (tests/data/balloon_on_lid.yaml):
 # the lid's faces on the chamber are summed over the ranks that own them (its rigid volume and the
@@ -240,6 +246,15 @@ same(lid1 lid2 1e-7 coupling.chamber_pressure)
 run_pair(lumped_lid ${DATA}/balloon_lumped_on_lid.yaml)
 same(lumped_lid1 lumped_lid2 1e-8 bodies.body.lid.displacement membrane.top.centreUy)
 same(lumped_lid1 lumped_lid2 1e-7 coupling.chamber_pressure)
+# A membrane between two closed regions (tests/data/balloon_nested.yaml), each membrane solved by
+# its own rank: the two regions' multipliers are solved together from both membranes' answers.
+# On 2 ranks as on one: the deflections to 1e-8, the volumes to 1e-10, the pressures to 1e-6
+# (measured 8e-11, 2e-11, 4e-8 at 2 s).
+run_pair(nested ${DATA}/balloon_nested.yaml)
+same(nested1 nested2 1e-8 membrane.lower.centreUy membrane.upper.centreUy)
+same(nested1 nested2 1e-10 coupling.chamber_volume.lower coupling.chamber_volume.upper)
+same(nested1 nested2 1e-6 coupling.chamber_pressure.lower coupling.chamber_pressure.upper)
+one_each(nested2 lower upper)
 
 # The VAD pump with both chambers meshed (cases/vad-two-chambers.yaml: the air closed by the
 # membrane's volume constraint, the mesh moved by 482 columns on both sides of the membrane, which
