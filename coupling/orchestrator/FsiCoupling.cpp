@@ -1470,7 +1470,6 @@ void FsiCoupling::advance(const TimeState& t) {
     c.rigidStart = c.rigidNow = rigidVolumeAt(c, qGood);
     c.volumeStart = c.rigidStart;
     bool patches = true;  // every wall a membrane patch (none a baffle)
-    double pa = 0, a = 0;  // the fluid's load on the walls, integrated, and their area
     for (ChamberWall& w : c.walls) {
       Panel& p = panels_[static_cast<std::size_t>(w.panel)];
       MembraneSolver& s = p.module->solver();
@@ -1478,7 +1477,12 @@ void FsiCoupling::advance(const TimeState& t) {
       w.volumeStart = w.sign * s.enclosedVolume(p.iterate);
       c.volumeStart += w.volumeStart;
       patches = patches && p.iface.side == coupling::InterfaceSide::Patch;
-      const std::vector<real>& areas = s.mesh().elementAreas();
+    }
+    double pa = 0, a = 0;  // patches: the fluid's load on the walls, integrated, and their area
+    for (const ChamberWall& w : c.walls) {
+      if (!patches || c.lumped) break;
+      const Panel& p = panels_[static_cast<std::size_t>(w.panel)];
+      const std::vector<real>& areas = p.module->solver().mesh().elementAreas();
       auto h = Kokkos::create_mirror_view_and_copy(HostSpace(), p.load);
       for (std::size_t e = 0; e < areas.size(); ++e) {
         pa += areas[e] * h(e);
