@@ -1437,8 +1437,18 @@ void FsiCoupling::advance(const TimeState& t) {
     if (!std::isfinite(nr) || (smallestResidual > 0 && nr > kResidualGrowthLimit * smallestResidual)) {
       std::ostringstream os;
       os << "coupling: the interface residual grew from " << smallestResidual << " to " << nr << " within the step to t = "
-         << t1 << " (" << last_.iterations << " iterations): the coupling iteration diverges; with Aitken, a strong "
-         << "added mass may need omegaMin below 1 / (1 + m_added / m), or IQN-ILS (iqnMaxCols > 0)";
+         << t1 << " (" << last_.iterations << " iterations): the coupling iteration diverges; ";
+      // A fluid whose outer loop stops short of its tolerance answers each iterate with its own
+      // error: that, not the coupling, is then what to mend first.
+      const fluid::StepResult& fr = fluid_->lastStep();
+      const fluid::PimpleOptions& po = fluid_->solver().options().pimple;
+      if (po.outerTolerance > 0 && !fr.converged)
+        os << "the fluid's outer loop did not converge in its last solve (" << fr.outerIterations
+           << " outer correctors, final pressure residual " << fr.finalPressureResidual << " against outerTolerance "
+           << po.outerTolerance << "): more fluid.pimple.correctors or nonOrthogonalCorrectors, or a smaller time "
+           << "step, may be needed; ";
+      os << "with Aitken, a strong added mass may need omegaMin below 1 / (1 + m_added / m), or IQN-ILS "
+         << "(iqnMaxCols > 0)";
       throw DivergenceError(os.str());
     }
     const bool small = last_.displacementResidual < options_.fsiTol &&
