@@ -179,7 +179,8 @@ Schema couplingSchema() {
                            "one multiplier, a uniform pressure, makes its swept volume equal the inflow, so the fluid "
                            "always has a consistent answer (a region bounded by several membranes shares one "
                            "multiplier among them; a membrane between two closed regions carries the difference of "
-                           "theirs; coupled bodies that bound it or carry its membrane take it too); "
+                           "theirs; coupled bodies that bound it or carry its membrane, on one body or blended "
+                           "between several, take it too); "
                            "false: plain Dirichlet-Neumann coupling"),
            Default(o.volumeConstraint))
       .key("viscousTraction",

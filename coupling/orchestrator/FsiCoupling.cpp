@@ -247,8 +247,11 @@ void FsiCoupling::addMovingWalls(Chamber& c, const std::vector<int>& cellRegion,
     const Panel& p = panels_[static_cast<std::size_t>(w.panel)];
     if (!p.mounted) continue;
     w.parent = singleParent(p);
+    w.blended = w.parent < 0;
+    blended_ = blended_ || w.blended;
     const MembraneMesh& mm = p.module->solver().mesh();
     w.rigid = RealView("mfsi::coupling::chamberRigidWall", 3 * mm.nNodes());
+    if (w.blended) w.relative = RealView("mfsi::coupling::chamberBlendedWall", 3 * mm.nNodes());
     w.pressure = RealView("mfsi::coupling::chamberWallMultiplier", mm.nElements());
   }
   // The bodies' faces on the region, each counted by the rank that owns its cell.
@@ -377,10 +380,6 @@ void FsiCoupling::setUpChamber(const SceneConfig& section) {
       if (!p.dynamic)
         throw InputError(where, p.module->name() + " closes a fluid region: its volume constraint needs the "
                                 "dynamic analysis (membranes.N.analysis: dynamic)");
-      if (p.mounted && singleParent(p) < 0)
-        throw InputError(where, p.module->name() + " closes a fluid region on several moving bodies "
-                                "(parentBodyPatches of two bodies): a volume constraint for a membrane blended "
-                                "between bodies is not supported; mount it on one body");
       // A membrane that closes a chamber on its other side too (a fluid region or a lumped one)
       // carries both chambers' multipliers (groupChambers).
       // The membrane's element normals are the fluid faces' area vectors (the master side's on a
@@ -565,7 +564,7 @@ bool FsiCoupling::moveShares(const ChamberGroup& g, bool resolved) {
 void FsiCoupling::checkChamberVolume(const InterfaceVector& x) {
   const Eigen::VectorXd q = bodyCoordinates(x);
   for (Chamber& c : chambers_) {
-    double volume = rigidVolumeAt(c, q);
+    double volume = rigidVolumeAt(c, q, &x);
     for (const ChamberWall& w : c.walls) {
       Panel& p = panels_[static_cast<std::size_t>(w.panel)];
       MembraneSolver& s = p.module->solver();
@@ -576,7 +575,7 @@ void FsiCoupling::checkChamberVolume(const InterfaceVector& x) {
   }
 }
 
-double FsiCoupling::rigidVolume(Chamber& c, const std::vector<RigidPlacement>& t) {
+double FsiCoupling::rigidVolume(Chamber& c, const std::vector<RigidPlacement>& t, const InterfaceVector* x) {
   // The bodies' faces: the exact trilinear volume each sweeps from its reference corners to
   // their rigidly moved places (what the fluid's swept-volume fluxes of those faces add up to).
   double v = 0;
@@ -595,25 +594,70 @@ double FsiCoupling::rigidVolume(Chamber& c, const std::vector<RigidPlacement>& t
     }
   if (domain_.distributed() && !c.bodies.empty()) MPI_Allreduce(MPI_IN_PLACE, &v, 1, MPI_DOUBLE, MPI_SUM, domain_.comm);
   // Mounted walls carried undeformed by their body: a rigid motion keeps the volume between the
-  // carried and the deformed membrane, so the frame-relative volume adds to this exactly.
+  // carried and the deformed membrane, so the frame-relative volume adds to this exactly. A wall
+  // blended between bodies does not move rigidly: its placed volume at its displacement u, less
+  // u's frame-relative volume (which the walls' targets count).
   for (ChamberWall& w : c.walls) {
-    if (w.parent < 0) continue;
+    if (w.parent < 0 && !w.blended) continue;
+    const Panel& p = panels_[static_cast<std::size_t>(w.panel)];
     MembraneSolver& s = memberSolver(w);
     const auto& X = s.mesh().hostPoints();
     auto h = Kokkos::create_mirror_view(w.rigid);
+    if (!w.blended) {
+      for (std::size_t i = 0; i < X.size(); ++i) {
+        const std::array<real, 3> y = t[static_cast<std::size_t>(w.parent)].apply(X[i]);
+        for (int k = 0; k < 3; ++k) h(3 * i + k) = y[k] - X[i][k];
+      }
+      Kokkos::deep_copy(w.rigid, h);
+      v += s.enclosedVolume(w.rigid);
+      continue;
+    }
+    if (x != nullptr)
+      copySegmentToDevice(*x, p.offset, w.relative);
+    else
+      Kokkos::deep_copy(w.relative, p.dynamic && s.hasTrial() ? s.trialDisplacement() : s.displacement());
+    auto u = Kokkos::create_mirror_view_and_copy(HostSpace(), w.relative);
     for (std::size_t i = 0; i < X.size(); ++i) {
-      const std::array<real, 3> y = t[static_cast<std::size_t>(w.parent)].apply(X[i]);
+      std::array<real, 3> y{0, 0, 0};
+      const std::array<real, 3> at{X[i][0] + u(3 * i), X[i][1] + u(3 * i + 1), X[i][2] + u(3 * i + 2)};
+      for (int b = 0; b < p.parents.nBodies(); ++b) {
+        const double weight = p.parents.weight(i, b);
+        if (weight == 0) continue;
+        const std::array<real, 3> yb = t[static_cast<std::size_t>(b)].apply(at);
+        for (int k = 0; k < 3; ++k) y[k] += weight * yb[k];
+      }
       for (int k = 0; k < 3; ++k) h(3 * i + k) = y[k] - X[i][k];
     }
     Kokkos::deep_copy(w.rigid, h);
-    v += s.enclosedVolume(w.rigid);
+    v += s.enclosedVolume(w.rigid) - s.enclosedVolume(w.relative);
   }
   return v;
 }
 
-double FsiCoupling::rigidVolumeAt(Chamber& c, const Eigen::VectorXd& q) {
+double FsiCoupling::rigidVolumeAt(Chamber& c, const Eigen::VectorXd& q, const InterfaceVector* x) {
   if (q.size() == 0 || !c.moving()) return 0;
-  return rigidVolume(c, placementsOf(q));
+  return rigidVolume(c, placementsOf(q), x);
+}
+
+double FsiCoupling::blendedMiss(const InterfaceVector* x) {
+  double worst = 0;
+  const Eigen::VectorXd q = x != nullptr ? bodyCoordinates(*x) : Eigen::VectorXd(rigid_->system().q());
+  for (Chamber& c : chambers_) {
+    if (std::none_of(c.walls.begin(), c.walls.end(), [](const ChamberWall& w) { return w.blended; })) continue;
+    double volume = rigidVolumeAt(c, q, x), tolerance = 0;
+    for (const ChamberWall& w : c.walls) {
+      Panel& p = panels_[static_cast<std::size_t>(w.panel)];
+      MembraneSolver& s = p.module->solver();
+      if (x != nullptr) copySegmentToDevice(*x, p.offset, p.iterate);
+      const ConstRealView u = x != nullptr                    ? ConstRealView(p.iterate)
+                              : p.dynamic && s.hasTrial() ? ConstRealView(s.trialDisplacement())
+                                                          : ConstRealView(s.displacement());
+      volume += w.sign * s.enclosedVolume(u);
+      tolerance = std::max(tolerance, double(s.volumeTolerance()));
+    }
+    worst = std::max(worst, std::abs(volume - (c.volumeStart + c.volumeStep)) / tolerance);
+  }
+  return worst;
 }
 
 Eigen::VectorXd FsiCoupling::bodyCoordinates(const InterfaceVector& x) const {
@@ -994,7 +1038,7 @@ void FsiCoupling::applyBodyLoads() {
         moment += lambda * (Q * cb.moment) + lever.cross(f);
       }
       for (ChamberWall& w : ch.walls) {
-        if (w.parent != static_cast<int>(slot)) continue;
+        if (w.parent != static_cast<int>(slot) && !w.blended) continue;  // blended: by its weights
         const Panel& p = panels_[static_cast<std::size_t>(w.panel)];
         MembraneSolver& s = memberSolver(w);
         Kokkos::deep_copy(exec_, w.pressure, s.volumeConstraint().sign * lambda);
@@ -1060,6 +1104,9 @@ void FsiCoupling::solveStructure(double t1, double dt) {
       c.maxSweepsRun = std::max(c.maxSweepsRun, c.sweeps);
       again = true;
     }
+    // A wall blended between bodies: its volume beyond the frame-relative one moved with its
+    // solve; the walls' targets follow it (followBodies) until the chambers' volumes hold.
+    if (!again && blended_ && sweep + 1 < kMaxShareRounds && blendedMiss(nullptr) > 1) again = true;
     if (!again) break;
     applyBodyLoads();
   }
@@ -1196,13 +1243,8 @@ void FsiCoupling::gatherTrial(InterfaceVector& xt) const {
   if (!bodies_.empty()) xt.segment(bodyOffset_, rigid_->system().nDof()) = rigid_->system().q();
 }
 
-void FsiCoupling::setTrial(InterfaceVector& x) {
-  // A region bounded by several membranes: x's split of the volume among them is the
-  // acceleration's (the mode in which they trade volume through the fluid is where a strong added
-  // mass lives), so only the total is corrected, the miss shared by the walls' compliances (a
-  // uniform change of the region's pressure). The structure solve's shares are kept for its next solve.
-  // With moving walls the walls' total is what the bodies' places at x leave.
-  std::vector<std::pair<MembraneVolumeConstraint*, real>> shares;
+void FsiCoupling::targetsFor(const InterfaceVector& x,
+                             std::vector<std::pair<MembraneVolumeConstraint*, real>>* saved) {
   const Eigen::VectorXd q = bodyCoordinates(x);
   for (const ChamberGroup& g : groups_) {
     if (g.panels.size() < 2 && !chambers_[static_cast<std::size_t>(g.chambers[0])].moving()) continue;
@@ -1215,27 +1257,44 @@ void FsiCoupling::setTrial(InterfaceVector& x) {
     Eigen::VectorXd miss(static_cast<Eigen::Index>(g.chambers.size()));
     for (std::size_t r = 0; r < g.chambers.size(); ++r) {
       Chamber& c = chambers_[static_cast<std::size_t>(g.chambers[r])];
-      miss[static_cast<Eigen::Index>(r)] = c.volumeStart + c.volumeStep - rigidVolumeAt(c, q);
+      miss[static_cast<Eigen::Index>(r)] = c.volumeStart + c.volumeStep - rigidVolumeAt(c, q, &x);
     }
     miss -= g.incidence * volume;
     const Eigen::VectorXd share = shareOut(g, wallWeights(g), miss);
     for (std::size_t j = 0; j < g.panels.size(); ++j) {
       MembraneVolumeConstraint& vc = panels_[static_cast<std::size_t>(g.panels[j])].module->solver().volumeConstraint();
-      shares.emplace_back(&vc, vc.target);
+      if (saved != nullptr) saved->emplace_back(&vc, vc.target);
       vc.target = volume[static_cast<Eigen::Index>(j)] + share[static_cast<Eigen::Index>(j)];
     }
   }
-  for (std::size_t i = 0; i < panels_.size(); ++i) {
-    Panel& p = panels_[i];
+}
+
+void FsiCoupling::setTrial(InterfaceVector& x) {
+  // A region bounded by several membranes: x's split of the volume among them is the
+  // acceleration's (the mode in which they trade volume through the fluid is where a strong added
+  // mass lives), so only the total is corrected, the miss shared by the walls' compliances (a
+  // uniform change of the region's pressure). The structure solve's shares are kept for its next solve.
+  // With moving walls the walls' total is what the bodies' places at x leave. A wall blended
+  // between bodies adds a volume of its own displacement to that: the targets and the projection
+  // repeat until the chambers' volumes hold at x.
+  std::vector<std::pair<MembraneVolumeConstraint*, real>> shares;
+  for (int pass = 0;; ++pass) {
+    targetsFor(x, pass == 0 ? &shares : nullptr);
+    for (std::size_t i = 0; i < panels_.size(); ++i) {
+      Panel& p = panels_[i];
+      if (!p.dynamic || chamberOf(static_cast<int>(i)) < 0) continue;
+      // A relaxed iterate misses the volume to second order in its update: the fluid must get one
+      // it can follow.
+      copySegmentToDevice(x, p.offset, p.iterate);
+      p.module->solver().projectOntoVolume(p.iterate);
+      copySegmentToHost(p.iterate, x, p.offset);
+    }
+    if (!blended_ || pass + 1 >= kMaxShareRounds || blendedMiss(&x) <= 1) break;
+  }
+  for (Panel& p : panels_) {
     MembraneSolver& s = p.module->solver();
     if (p.dynamic) {
       copySegmentToDevice(x, p.offset, p.iterate);
-      if (chamberOf(static_cast<int>(i)) >= 0) {
-        // A relaxed iterate misses the volume to second order in its update: the fluid must get one
-        // it can follow.
-        s.projectOntoVolume(p.iterate);
-        copySegmentToHost(p.iterate, x, p.offset);
-      }
       s.setTrialDisplacement(p.iterate);
     } else {
       copySegmentToDevice(x, p.offset, s.displacement());
@@ -1477,7 +1536,7 @@ void FsiCoupling::advance(const TimeState& t) {
   for (Chamber& c : chambers_) {
     // The fluid mesh ends the step at `good` (the last iterate moved to): the next step's start.
     const double start = c.volumeStart;
-    c.rigidStart = c.rigidNow = rigidVolumeAt(c, qGood);
+    c.rigidStart = c.rigidNow = rigidVolumeAt(c, qGood, &good);
     c.volumeStart = c.rigidStart;
     bool patches = true;  // every wall a membrane patch (none a baffle)
     for (ChamberWall& w : c.walls) {

@@ -271,7 +271,9 @@ class FsiCoupling final : public Module {
     real sign = 1;
     double volumeStart = 0;  ///< its share of the region's volume change at the step's start (frame-relative; x sign)
     int parent = -1;         ///< mounted: the coupled-body slot of its one parent body
+    bool blended = false;    ///< mounted on several bodies, each node blended between them (ParentFrames)
     RealView rigid;          ///< mounted: its nodes' displacement were they carried rigidly by the body
+    RealView relative;       ///< blended: its frame-relative displacement (rigidVolume's work space)
     RealView pressure;       ///< mounted: its multiplier on every element (what its body receives of it)
   };
   /// A coupled body's faces that bound a chamber: as the body moves they change its volume, and
@@ -311,7 +313,7 @@ class FsiCoupling final : public Module {
     /// Bodies bound it or carry one of its walls.
     bool moving() const {
       return !bodies.empty() ||
-             std::any_of(walls.begin(), walls.end(), [](const ChamberWall& w) { return w.parent >= 0; });
+             std::any_of(walls.begin(), walls.end(), [](const ChamberWall& w) { return w.parent >= 0 || w.blended; });
     }
   };
   /// Chambers that share a wall (a membrane between two closed regions) and their walls'
@@ -336,10 +338,20 @@ class FsiCoupling final : public Module {
   void addMovingWalls(Chamber& c, const std::vector<int>& cellRegion, int region);
   /// The bodies' rigid motions at coordinates q (the placements placeBodies applies).
   std::vector<RigidPlacement> placementsOf(const Eigen::VectorXd& q) const;
-  /// A chamber's volume change by its bodies' rigid motions `t` (collective on several ranks).
-  double rigidVolume(Chamber& c, const std::vector<RigidPlacement>& t);
+  /// A chamber's volume change by its bodies' rigid motions `t` (collective on several ranks):
+  /// their faces, the walls mounted on one body carried undeformed, and for a wall blended between
+  /// bodies what its placement at its frame-relative displacement (x's, or with x null its
+  /// solver's trial) adds to that displacement's frame-relative volume.
+  double rigidVolume(Chamber& c, const std::vector<RigidPlacement>& t, const coupling::InterfaceVector* x);
   /// The chamber's bodies at coordinates q (empty: no bodies): rigidVolume, 0 without moving walls.
-  double rigidVolumeAt(Chamber& c, const Eigen::VectorXd& q);
+  double rigidVolumeAt(Chamber& c, const Eigen::VectorXd& q, const coupling::InterfaceVector* x = nullptr);
+  /// Chambers with blended walls: the largest miss of their volume at x (null: the walls' trials)
+  /// over the walls' volume tolerance.
+  double blendedMiss(const coupling::InterfaceVector* x);
+  /// Every chamber's walls' volume targets for the iterate x (the groups' totals at x's bodies,
+  /// shared by compliance); `saved` receives the targets replaced (when not null).
+  void targetsFor(const coupling::InterfaceVector& x,
+                  std::vector<std::pair<MembraneVolumeConstraint*, real>>* saved);
   /// x's block of the bodies' coordinates (empty without bodies).
   Eigen::VectorXd bodyCoordinates(const coupling::InterfaceVector& x) const;
   /// Chambers with moving walls: the walls' targets follow the bodies' trial coordinates (the
@@ -364,6 +376,7 @@ class FsiCoupling final : public Module {
   }
   std::vector<Chamber> chambers_;
   std::vector<ChamberGroup> groups_;
+  bool blended_ = false;  ///< a chamber wall is blended between bodies
 };
 
 /// Catalogue entry of the `coupling` section (needs the `fluid` section and at least one membrane

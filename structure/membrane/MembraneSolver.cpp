@@ -365,9 +365,11 @@ real MembraneSolver::enclosedVolumeAt(const ConstRealView& u, const RealView& gr
 
 real MembraneSolver::enclosedVolume(const ConstRealView& u) { return enclosedVolumeAt(u, volumeGrad_); }
 
+real MembraneSolver::volumeTolerance() const { return volume_.tolerance * mesh_.referenceArea() * lchar_; }
+
 real MembraneSolver::projectOntoVolume(const RealView& u) {
   const lid_t n3 = 3 * mesh_.nNodes();
-  const real tol = volume_.tolerance * mesh_.referenceArea() * lchar_;
+  const real tol = volumeTolerance();
   Kokkos::deep_copy(exec_, volumeDu_, u);
   // Newton on the step length along the projected gradient: V is smooth and the moves are small
   // (a relaxation's second-order volume error), so two or three steps reach round-off.
@@ -788,7 +790,7 @@ MembraneSolveReport MembraneSolver::solveStep(real dt) {
   auto kinematics = [&]() { trialKinematics(); };
   const auto& nopt = options_.newton;
   const bool constrained = volume_.active;
-  const real volumeTol = volume_.tolerance * mesh_.referenceArea() * lchar_;
+  const real volumeTol = volumeTolerance();
   // The step's residual at the trial displacement (and the multiplier): rhs = (1-af) R1 + af Rn
   // - M((1-am) a1 + am an) - C((1-af) v1 + af vn) [- the interface mass term]. Returns |M a_mid|.
   auto stepResidual = [&]() {

@@ -101,6 +101,9 @@ class MembraneSolver {
   MembraneSolveReport solveStep(real dt);
   /// Trial state at time() + dt of the last `solveStep` (3 per node).
   RealView trialDisplacement() const { return uTrial_; }
+  /// A trial state of this step is held (solveStep, adoptStep or setTrialDisplacement since the
+  /// last commitStep or discardStep).
+  bool hasTrial() const { return trial_.valid; }
   RealView trialVelocity() const { return v1_; }
   RealView trialAcceleration() const { return a1_; }
   /// \brief Replace the trial displacement (a relaxed FSI update); the trial velocity and
@@ -133,6 +136,8 @@ class MembraneSolver {
   /// sign * (the volume the membrane swept from its reference to u): the constrained region's
   /// volume change at displacement u.
   real enclosedVolume(const ConstRealView& u);
+  /// The volume misses the constrained solves and projectOntoVolume accept [m^3].
+  real volumeTolerance() const;
   /// \brief Move u along the (constrained) volume gradient until enclosedVolume(u) = target to the
   /// constraint's tolerance (a relaxed FSI iterate the fluid must be able to follow). Returns the
   /// largest nodal move.

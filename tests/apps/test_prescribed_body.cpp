@@ -57,7 +57,9 @@ std::map<std::string, double> runLiftedBottom(bool lifted, double endTime, const
       yaml, "lifted-bottom.yaml", mfsi::sceneSchema(),
       {"mesh.blocks.0.cells=[16,14,1]", "mesh.blocks.1.cells=[16,2,1]", "time.endTime=" + std::to_string(endTime)});
   mfsi::Simulation sim(cfg);
-  const std::string dir = ::testing::TempDir() + (lifted ? "/lifted_bottom" : "/rigid_bottom") + (bodies.empty() ? "" : "_reach");
+  // One folder per test: ctest runs the tests of this file side by side.
+  const std::string dir = ::testing::TempDir() + "/" + ::testing::UnitTest::GetInstance()->current_test_info()->name() +
+                          (lifted ? "_lifted_bottom" : "_rigid_bottom") + (bodies.empty() ? "" : "_reach");
   std::filesystem::create_directories(dir);
   return sim.run(dir, false).metrics;
 }
