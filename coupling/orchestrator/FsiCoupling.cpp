@@ -563,16 +563,23 @@ bool FsiCoupling::moveShares(const ChamberGroup& g, bool resolved) {
 
 void FsiCoupling::checkChamberVolume(const InterfaceVector& x) {
   const Eigen::VectorXd q = bodyCoordinates(x);
-  for (Chamber& c : chambers_) {
-    double volume = rigidVolumeAt(c, q, &x);
-    for (const ChamberWall& w : c.walls) {
-      Panel& p = panels_[static_cast<std::size_t>(w.panel)];
-      MembraneSolver& s = p.module->solver();
-      copySegmentToDevice(x, p.offset, p.iterate);
-      volume += w.sign * s.enclosedVolume(p.iterate);
-    }
-    c.volumeMiss = std::max(c.volumeMiss, std::abs(volume - (c.volumeStart + c.volumeStep)));
+  for (Chamber& c : chambers_)
+    c.volumeMiss = std::max(c.volumeMiss, std::abs(chamberVolume(c, q, &x) - (c.volumeStart + c.volumeStep)));
+}
+
+RealView FsiCoupling::wallDisplacement(const Panel& p) const {
+  MembraneSolver& s = p.module->solver();
+  return p.dynamic && s.hasTrial() ? s.trialDisplacement() : s.displacement();
+}
+
+double FsiCoupling::chamberVolume(Chamber& c, const Eigen::VectorXd& q, const InterfaceVector* x) {
+  double volume = rigidVolumeAt(c, q, x);
+  for (const ChamberWall& w : c.walls) {
+    Panel& p = panels_[static_cast<std::size_t>(w.panel)];
+    if (x != nullptr) copySegmentToDevice(*x, p.offset, p.iterate);
+    volume += w.sign * p.module->solver().enclosedVolume(x != nullptr ? p.iterate : wallDisplacement(p));
   }
+  return volume;
 }
 
 double FsiCoupling::rigidVolume(Chamber& c, const std::vector<RigidPlacement>& t, const InterfaceVector* x) {
@@ -615,7 +622,7 @@ double FsiCoupling::rigidVolume(Chamber& c, const std::vector<RigidPlacement>& t
     if (x != nullptr)
       copySegmentToDevice(*x, p.offset, w.relative);
     else
-      Kokkos::deep_copy(w.relative, p.dynamic && s.hasTrial() ? s.trialDisplacement() : s.displacement());
+      Kokkos::deep_copy(w.relative, wallDisplacement(p));
     auto u = Kokkos::create_mirror_view_and_copy(HostSpace(), w.relative);
     for (std::size_t i = 0; i < X.size(); ++i) {
       std::array<real, 3> y{0, 0, 0};
@@ -644,18 +651,9 @@ double FsiCoupling::blendedMiss(const InterfaceVector* x) {
   const Eigen::VectorXd q = x != nullptr ? bodyCoordinates(*x) : Eigen::VectorXd(rigid_->system().q());
   for (Chamber& c : chambers_) {
     if (std::none_of(c.walls.begin(), c.walls.end(), [](const ChamberWall& w) { return w.blended; })) continue;
-    double volume = rigidVolumeAt(c, q, x), tolerance = 0;
-    for (const ChamberWall& w : c.walls) {
-      Panel& p = panels_[static_cast<std::size_t>(w.panel)];
-      MembraneSolver& s = p.module->solver();
-      if (x != nullptr) copySegmentToDevice(*x, p.offset, p.iterate);
-      const ConstRealView u = x != nullptr                    ? ConstRealView(p.iterate)
-                              : p.dynamic && s.hasTrial() ? ConstRealView(s.trialDisplacement())
-                                                          : ConstRealView(s.displacement());
-      volume += w.sign * s.enclosedVolume(u);
-      tolerance = std::max(tolerance, double(s.volumeTolerance()));
-    }
-    worst = std::max(worst, std::abs(volume - (c.volumeStart + c.volumeStep)) / tolerance);
+    double tolerance = 0;
+    for (const ChamberWall& w : c.walls) tolerance = std::max(tolerance, double(memberSolver(w).volumeTolerance()));
+    worst = std::max(worst, std::abs(chamberVolume(c, q, x) - (c.volumeStart + c.volumeStep)) / tolerance);
   }
   return worst;
 }

@@ -345,6 +345,10 @@ class FsiCoupling final : public Module {
   double rigidVolume(Chamber& c, const std::vector<RigidPlacement>& t, const coupling::InterfaceVector* x);
   /// The chamber's bodies at coordinates q (empty: no bodies): rigidVolume, 0 without moving walls.
   double rigidVolumeAt(Chamber& c, const Eigen::VectorXd& q, const coupling::InterfaceVector* x = nullptr);
+  /// A wall's displacement now: its trial of this step if it has one, else its committed one.
+  RealView wallDisplacement(const Panel& p) const;
+  /// A chamber's volume change with its bodies at q and its walls at x (null: wallDisplacement).
+  double chamberVolume(Chamber& c, const Eigen::VectorXd& q, const coupling::InterfaceVector* x);
   /// Chambers with blended walls: the largest miss of their volume at x (null: the walls' trials)
   /// over the walls' volume tolerance.
   double blendedMiss(const coupling::InterfaceVector* x);
