@@ -46,6 +46,8 @@
 #include "coupling/FluidModule.hpp"
 #include "coupling/MembraneModule.hpp"
 #include "coupling/RigidModule.hpp"
+#include "coupling/chambers/Chamber.hpp"
+#include "coupling/chambers/ChamberGroup.hpp"
 #include "coupling/motion/BodyPatchMotion.hpp"
 #include "coupling/motion/ParentFrames.hpp"
 #include "coupling/motion/RigidBlend.hpp"
@@ -258,71 +260,11 @@ class FsiCoupling final : public Module {
             limitedTotal_ = 0;
   int maxIterations_ = 0;
   double minJacobian_ = 1;
-  /// A closed fluid region (or the whole closed domain, or a lumped gas chamber behind a membrane),
-  /// the membranes that bound it, and the volume bookkeeping of their constraint. One per closed
-  /// region. A region bounded by several membranes carries one multiplier (its uniform pressure)
-  /// on all of them: each membrane solves with a share of the region's volume target as its own,
-  /// and the shares move until the multipliers agree (solveStructure).
-  struct ChamberWall {
-    int panel = -1;          ///< index into panels_
-    /// +1: the region grows with its membrane's constrained volume (the region the membrane's
-    /// MembraneVolumeConstraint::sign was set for); -1: a membrane between two closed regions, seen
-    /// from the second one, which it shrinks.
-    real sign = 1;
-    double volumeStart = 0;  ///< its share of the region's volume change at the step's start (frame-relative; x sign)
-    int parent = -1;         ///< mounted: the coupled-body slot of its one parent body
-    bool blended = false;    ///< mounted on several bodies, each node blended between them (ParentFrames)
-    RealView rigid;          ///< mounted: its nodes' displacement were they carried rigidly by the body
-    RealView relative;       ///< blended: its frame-relative displacement (rigidVolume's work space)
-    RealView pressure;       ///< mounted: its multiplier on every element (what its body receives of it)
-  };
-  /// A coupled body's faces that bound a chamber: as the body moves they change its volume, and
-  /// the chamber's pressure pushes on them.
-  struct ChamberBody {
-    int slot = -1;
-    std::vector<std::array<double, 12>> faces;  ///< this rank's (owned) faces: reference corners
-    Eigen::Vector3d area = Eigen::Vector3d::Zero();    ///< sum of their area vectors out of the fluid (all ranks)
-    Eigen::Vector3d moment = Eigen::Vector3d::Zero();  ///< sum of (centroid - start centre of mass) x area (all ranks)
-  };
-  struct Chamber {
-    std::vector<ChamberWall> walls;
-    std::vector<ChamberBody> bodies;  ///< bodies that bound it (the parents of mounted walls among them)
-    int fluidRegion = -1;      ///< the fluid's closed region (FluidSolver::addClosedRegion); -1: the whole domain
-    bool lumped = false;       ///< an unmeshed gas chamber behind the membrane (coupling.lumpedChamber)
-    int group = -1;            ///< its group in groups_ (the chambers it shares walls with)
-    double volumeStart = 0;    ///< the chamber's volume change where the fluid mesh is at the step's start
-    /// Moving walls (bodies, mounted membranes): the volume change the bodies' rigid motion makes
-    /// (mounted membranes carried undeformed), at the step's start and for the walls' current
-    /// targets. The walls' frame-relative volumes make up the rest.
-    double rigidStart = 0, rigidNow = 0;
-    double sweptLast = 0;      ///< what the membranes swept in the last step (the BDF2 mesh flux reads it)
-    double maxMissRun = 0;     ///< largest volume miss of the run [m^3]
-    int maxRoundsRun = 0;      ///< most share rounds of one structure solve in the run
-    int maxSweepsRun = 0;      ///< most bodies' multiplier sweeps of one structure solve in the run
-    // This step's:
-    double volumeStep = 0;     ///< the target's change over the step [m^3]
-    double volumeMiss = 0;     ///< largest |volume change - target| of its iterates [m^3]
-    double pressure = 0;       ///< the chamber's pressure [Pa]
-    double lambda = 0;         ///< the multiplier of the last structure solve (several walls: their agreed one)
-    /// Moving walls: the multiplier the bodies were last solved with (the structure solve iterates
-    /// it by secant until the walls' multiplier returns it).
-    double bodyLambda = 0, bodyLambdaStart = 0;  ///< ... and its value at the step's start
-    double spread = 0;         ///< several walls: max |lambda_i - lambda| / the pressure scale, last solve
-    int rounds = 0;            ///< several walls: most share rounds of one structure solve this step
-    int sweeps = 0;            ///< moving walls: most multiplier sweeps of one structure solve this step
-    /// Bodies bound it or carry one of its walls.
-    bool moving() const {
-      return !bodies.empty() ||
-             std::any_of(walls.begin(), walls.end(), [](const ChamberWall& w) { return w.parent >= 0 || w.blended; });
-    }
-  };
-  /// Chambers that share a wall (a membrane between two closed regions) and their walls'
-  /// panels: their multipliers are solved together. Most groups are one chamber.
-  struct ChamberGroup {
-    std::vector<int> chambers;  ///< indices into chambers_
-    std::vector<int> panels;    ///< every wall's panel once
-    Eigen::MatrixXd incidence;  ///< chambers x panels: each wall's sign in each chamber, 0 where it is none
-  };
+  // --- closed chambers (FsiChambers.cpp) ------------------------------------------------------
+  using Chamber = coupling::Chamber;
+  using ChamberWall = coupling::ChamberWall;
+  using ChamberBody = coupling::ChamberBody;
+  using ChamberGroup = coupling::ChamberGroup;
   /// Groups the chambers by their shared walls. Throws InputError (naming `where`) for a group whose
   /// pressures its walls cannot fix: closed regions bounded only by membranes between them (their
   /// inflows would fix one volume twice), or several chambers and a moving wall.
@@ -330,9 +272,6 @@ class FsiCoupling final : public Module {
   /// The walls' weights for sharing a volume: their compliances, or before every wall has one
   /// their reference areas.
   Eigen::VectorXd wallWeights(const ChamberGroup& g) const;
-  /// The volume change per wall (of `weight`-weighted least size) that changes the chambers'
-  /// volumes by d: W E^T (E W E^T)^-1 d, E the incidence.
-  Eigen::VectorXd shareOut(const ChamberGroup& g, const Eigen::VectorXd& weight, const Eigen::VectorXd& d) const;
   /// The new chamber's moving walls: its mounted walls' parents, and every coupled body's faces
   /// on the fluid region `region` (cellRegion: the region of each local cell).
   void addMovingWalls(Chamber& c, const std::vector<int>& cellRegion, int region);
@@ -374,6 +313,17 @@ class FsiCoupling final : public Module {
   /// true when the multipliers agreed to kShareAgreement x fsiTol before the move (nothing moved
   /// then), or when `resolved` (a solve on moved shares) and no wall took a Newton iteration.
   bool moveShares(const ChamberGroup& g, bool resolved);
+  /// A chamber's multiplier on coupled body `slot`: on its faces that bound the chamber and on the
+  /// mounted walls it carries, as those walls receive it (added to force and moment about the
+  /// body's loadCentre).
+  void addChamberLoads(std::size_t slot, Eigen::Vector3d& force, Eigen::Vector3d& moment);
+  /// The step's end, before the structure commits: each chamber's start volumes for the next step
+  /// where the fluid mesh ends the step (`good`, the last iterate moved to), what it swept, its
+  /// multiplier and pressure.
+  void endChamberStep(const coupling::InterfaceVector& good);
+  /// After the commit: the fluid's pressure level in each meshed chamber takes over the
+  /// multiplier (the walls' and bodies' multipliers and the walls' loads shift alike).
+  void shiftChamberLevels();
   /// A wall's membrane solver (the panels hold their modules by pointer).
   MembraneSolver& memberSolver(const ChamberWall& w) const {
     return panels_[static_cast<std::size_t>(w.panel)].module->solver();
