@@ -275,7 +275,7 @@ void FsiCoupling::groupChambers(const SourceLocation& where) {
   for (std::size_t k = 0; k < groups_.size(); ++k) {
     const ChamberGroup& g = groups_[k];
     for (int c : g.chambers) chambers_[static_cast<std::size_t>(c)].group = static_cast<int>(k);
-    if (g.chambers.size() == 1) continue;
+    if (g.pressuresFixed()) continue;
     std::string names;
     for (int c : g.chambers) {
       const Chamber& ch = chambers_[static_cast<std::size_t>(c)];
@@ -284,14 +284,10 @@ void FsiCoupling::groupChambers(const SourceLocation& where) {
         wallNames += (wallNames.empty() ? "" : " and ") + panels_[static_cast<std::size_t>(w.panel)].module->name();
       names += (names.empty() ? "" : ", ") + std::string(ch.lumped ? "the lumped chamber" : "the fluid region") +
                " of " + wallNames;
-      if (ch.moving())
-        throw InputError(where, "closed chambers that share a membrane cannot have moving walls (bodies, or "
-                                "membranes mounted on them): " + names);
     }
-    if (!g.pressuresFixed())
-      throw InputError(where, "closed chambers (" + names + ") are bounded only by the membranes between them: "
-                              "their inflows would fix the membranes' volumes twice and their pressures only "
-                              "up to a common level; give one of them a pressure boundary");
+    throw InputError(where, "closed chambers (" + names + ") are bounded only by the membranes between them: "
+                            "their inflows would fix the membranes' volumes twice and their pressures only "
+                            "up to a common level; give one of them a pressure boundary");
   }
 }
 
@@ -417,7 +413,7 @@ double FsiCoupling::rigidVolume(Chamber& c, const std::vector<RigidPlacement>& t
         for (int k = 0; k < 3; ++k) h(3 * i + k) = y[k] - X[i][k];
       }
       Kokkos::deep_copy(w.rigid, h);
-      v += s.enclosedVolume(w.rigid);
+      v += w.sign * s.enclosedVolume(w.rigid);
       continue;
     }
     if (x != nullptr)
@@ -437,7 +433,7 @@ double FsiCoupling::rigidVolume(Chamber& c, const std::vector<RigidPlacement>& t
       for (int k = 0; k < 3; ++k) h(3 * i + k) = y[k] - X[i][k];
     }
     Kokkos::deep_copy(w.rigid, h);
-    v += s.enclosedVolume(w.rigid) - s.enclosedVolume(w.relative);
+    v += w.sign * (s.enclosedVolume(w.rigid) - s.enclosedVolume(w.relative));
   }
   return v;
 }
@@ -463,12 +459,17 @@ void FsiCoupling::followBodies() {
   if (bodies_.empty()) return;
   const Eigen::VectorXd q = rigid_->system().q();
   for (const ChamberGroup& g : groups_) {
-    Chamber& c = chambers_[static_cast<std::size_t>(g.chambers[0])];  // moving walls: a group of one chamber
-    const double r = rigidVolumeAt(c, q), d = r - c.rigidNow;
-    if (d == 0) continue;
-    c.rigidNow = r;
-    // The walls' total follows; its split stays.
-    const Eigen::VectorXd share = coupling::shareOut(g, wallWeights(g), Eigen::VectorXd::Constant(1, -d));
+    // What the bodies' motion changed of each chamber's volume, since the walls' targets last took it.
+    Eigen::VectorXd d(static_cast<Eigen::Index>(g.chambers.size()));
+    for (std::size_t r = 0; r < g.chambers.size(); ++r) {
+      Chamber& c = chambers_[static_cast<std::size_t>(g.chambers[r])];
+      const double now = rigidVolumeAt(c, q);
+      d[static_cast<Eigen::Index>(r)] = now - c.rigidNow;
+      c.rigidNow = now;
+    }
+    if (d.isZero(0)) continue;
+    // The walls' totals follow; their split stays.
+    const Eigen::VectorXd share = coupling::shareOut(g, wallWeights(g), -d);
     for (std::size_t j = 0; j < g.panels.size(); ++j)
       panels_[static_cast<std::size_t>(g.panels[j])].module->solver().volumeConstraint().target +=
           share[static_cast<Eigen::Index>(j)];
@@ -542,7 +543,7 @@ void FsiCoupling::addChamberLoads(std::size_t slot, Eigen::Vector3d& force, Eige
       if (w.parent != static_cast<int>(slot) && !w.blended) continue;  // blended: by its weights
       const Panel& p = panels_[static_cast<std::size_t>(w.panel)];
       MembraneSolver& s = memberSolver(w);
-      Kokkos::deep_copy(exec_, w.pressure, s.volumeConstraint().sign * lambda);
+      Kokkos::deep_copy(exec_, w.pressure, s.volumeConstraint().sign * w.sign * lambda);
       const std::array<double, 6> L = p.parents.bodyLoad(exec_, static_cast<int>(slot), {c[0], c[1], c[2]},
                                                         s.mesh().elementNodes(), w.pressure, p.iface.front, 0,
                                                         p.surface.faceArea(), p.surface.faceCentroid());

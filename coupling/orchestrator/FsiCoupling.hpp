@@ -267,7 +267,7 @@ class FsiCoupling final : public Module {
   using ChamberGroup = coupling::ChamberGroup;
   /// Groups the chambers by their shared walls. Throws InputError (naming `where`) for a group whose
   /// pressures its walls cannot fix: closed regions bounded only by membranes between them (their
-  /// inflows would fix one volume twice), or several chambers and a moving wall.
+  /// inflows would fix one volume twice).
   void groupChambers(const SourceLocation& where);
   /// The walls' weights for sharing a volume: their compliances, or before every wall has one
   /// their reference areas.
