@@ -1,3 +1,8 @@
+/// \file
+/// \brief FsiCoupling's closed chambers (coupling/chambers/Chamber.hpp): finding them and their
+/// groups, each step's volume targets and their split among the walls, the walls' and bodies'
+/// volumes, the bodies' share of the multiplier, and the step's end (the fluid's pressure level
+/// takes over the multiplier). The orchestration that calls these is in FsiCoupling.cpp.
 #include "coupling/orchestrator/FsiCoupling.hpp"
 
 #include "core/Error.hpp"
@@ -10,12 +15,6 @@
 #include <algorithm>
 #include <cmath>
 #include <sstream>
-
-/// \file
-/// \brief FsiCoupling's closed chambers (coupling/chambers/Chamber.hpp): finding them and their
-/// groups, each step's volume targets and their split among the walls, the walls' and bodies'
-/// volumes, the bodies' share of the multiplier, and the step's end (the fluid's pressure level
-/// takes over the multiplier). The orchestration that calls these is in FsiCoupling.cpp.
 
 namespace mfsi {
 

@@ -1,12 +1,10 @@
 #include "coupling/orchestrator/FsiCoupling.hpp"
 
-#include "core/MeshRegions.hpp"
 #include "coupling/interface/InterfaceSegment.hpp"
 
 #include "core/io/HostCopy.hpp"
 
 #include "core/Error.hpp"
-#include "core/HexGeometry.hpp"
 #include "core/Suggest.hpp"
 #include "fluid/BoundaryConditions.hpp"
 #include "fluid/Loads.hpp"
