@@ -446,7 +446,7 @@ double FsiCoupling::blendedMiss(const InterfaceVector* x) {
   double worst = 0;
   const Eigen::VectorXd q = x != nullptr ? bodyCoordinates(*x) : Eigen::VectorXd(rigid_->system().q());
   for (Chamber& c : chambers_) {
-    if (std::none_of(c.walls.begin(), c.walls.end(), [](const ChamberWall& w) { return w.blended; })) continue;
+    if (!c.blended()) continue;
     double tolerance = 0;
     for (const ChamberWall& w : c.walls) tolerance = std::max(tolerance, double(memberSolver(w).volumeTolerance()));
     worst = std::max(worst, std::abs(chamberVolume(c, q, x) - (c.volumeStart + c.volumeStep)) / tolerance);
@@ -473,6 +473,13 @@ void FsiCoupling::followBodies() {
       panels_[static_cast<std::size_t>(g.panels[j])].module->solver().volumeConstraint().target +=
           share[static_cast<Eigen::Index>(j)];
   }
+}
+
+double FsiCoupling::chamberMultiplier(const Chamber& c) const {
+  // Several walls in its group: the agreed one of the last share round (a wall between two
+  // chambers carries the difference of theirs).
+  if (groups_[static_cast<std::size_t>(c.group)].panels.size() > 1) return c.lambda;
+  return memberSolver(c.walls[0]).volumeConstraint().lambda;
 }
 
 bool FsiCoupling::wallsIterated(const Chamber& c) const {
@@ -582,8 +589,7 @@ void FsiCoupling::endChamberStep(const InterfaceVector& good) {
       }
     }
     c.sweptLast = c.volumeStart - start;
-    if (groups_[static_cast<std::size_t>(c.group)].panels.size() == 1)
-      c.lambda = memberSolver(c.walls[0]).volumeConstraint().lambda;
+    c.lambda = chamberMultiplier(c);
     // A lumped chamber's pressure is the multiplier over the outside pressure its membrane's load
     // is taken against. Behind a baffle the load is the difference across it: the chamber's
     // pressure is the multiplier plus the fluid's mean over the chamber's cells. Behind patches:

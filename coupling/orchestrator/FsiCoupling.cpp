@@ -540,10 +540,7 @@ void FsiCoupling::solveStructure(double t1, double dt) {
     for (std::size_t k = 0; k < chambers_.size(); ++k) {
       Chamber& c = chambers_[k];
       if (!c.moving()) continue;
-      // Several walls in its group: the chambers' agreed multipliers (a shared wall carries a difference).
-      const double lambda = groups_[static_cast<std::size_t>(c.group)].panels.size() > 1
-                                ? c.lambda
-                                : double(memberSolver(c.walls[0]).volumeConstraint().lambda);
+      const double lambda = chamberMultiplier(c);
       const double miss = lambda - c.bodyLambda;
       // A sweep whose walls took no Newton iteration can tell no more.
       if ((sweep > 0 && !wallsIterated(c)) || std::abs(miss) <= kShareAgreement * options_.fsiTol * pressureScale(c))

@@ -302,6 +302,9 @@ class FsiCoupling final : public Module {
   void followBodies();
   /// The pressure a chamber's walls carry: the largest of their multipliers and element loads.
   double pressureScale(const Chamber& c) const;
+  /// The chamber's multiplier from its walls' last solve: its one wall's, or with several walls in
+  /// its group the agreed one (moveShares).
+  double chamberMultiplier(const Chamber& c) const;
   /// Some wall of the chamber took a Newton iteration in its last solve (else its target moved by
   /// less than its volume tolerance resolves).
   bool wallsIterated(const Chamber& c) const;
